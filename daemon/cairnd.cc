@@ -1,0 +1,173 @@
+#include "daemon/cairnd.h"
+
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+
+#include <spdlog/spdlog.h>
+
+#include "daemon/atomic_file.h"
+#include "daemon/options_yaml_writer.h"
+#include "daemon/pipeline.h"
+#include "daemon/run_summary.h"
+#include "daemon/systemd_notifier.h"
+#include "drivers/euroc_replay.h"
+#include "drivers/socketcan_wheel_driver.h"
+
+namespace cairn {
+namespace {
+
+const char* PacingName(ReplayPacing p) {
+  switch (p) {
+    case ReplayPacing::kRealTime: return "realtime";
+    case ReplayPacing::kScaled: return "scaled";
+    case ReplayPacing::kFastAsPossible: return "fast";
+  }
+  return "fast";
+}
+
+}  // namespace
+
+Cairnd::Cairnd(CairndOptions options, std::string config_path)
+    : options_(std::move(options)), config_path_(std::move(config_path)) {}
+
+void Cairnd::BlockTerminationSignals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+}
+
+Status Cairnd::Prepare() {
+  if (options_.source == SourceKind::kReplay) {
+    if (options_.replay.dataset.empty()) {
+      return InvalidArgumentError(config_path_ + ": replay.dataset is empty; give a dataset with --replay DIR");
+    }
+    auto ds = EurocDataset::Open(options_.replay.dataset);
+    if (!ds.ok()) return ds.status();
+    if (ds->imu().empty() && ds->stereo().empty()) {
+      return DataLossError(options_.replay.dataset + ": the dataset holds no IMU samples and no stereo pairs");
+    }
+    dataset_ = *ds;
+    sources_.push_back(std::make_unique<EurocReplay>(*ds, options_.replay));
+  }
+  if (options_.can.enabled) sources_.push_back(std::make_unique<SocketCanWheelDriver>(options_.can));
+  if (sources_.empty()) {
+    return InvalidArgumentError(config_path_ +
+                                ": no sensor source is enabled (this build has replay and SocketCAN "
+                                "wheel odometry; camera and IMU device drivers are not built yet)");
+  }
+  // Fail before any work if the output folder cannot be made.
+  std::error_code ec;
+  std::filesystem::create_directories(options_.output.dir, ec);
+  if (ec) return IoError(options_.output.dir + ": cannot create the output folder: " + ec.message());
+  return Status::Ok();
+}
+
+int Cairnd::Run() {
+  const auto wall_start = std::chrono::steady_clock::now();
+  RunInfo run;
+  run.robot = options_.robot.name;
+  run.mode = options_.source == SourceKind::kReplay ? "replay" : "live";
+
+  const ExecutorsOptions& ex = options_.executors;
+  if (ex.estimation.realtime || ex.stereo.realtime) {
+    run.memory_locked = Executor::LockProcessMemory(&run.memory_lock_note);
+    if (!run.memory_locked) spdlog::warn("memory not locked ({}); page faults may delay real-time threads", run.memory_lock_note);
+  }
+
+  PipelineRates rates;
+  if (dataset_) {
+    rates.imu_hz = dataset_->imu_calibration().rate_hz;
+    rates.camera_hz = dataset_->camera_rate_hz();
+  }
+  const bool deterministic = options_.source == SourceKind::kReplay && options_.replay.deterministic;
+  Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
+  pipeline.Start();
+  for (const ExecutorReport& e : pipeline.executor_reports()) {
+    if (e.realtime_requested && !e.realtime_granted) {
+      spdlog::warn("executor '{}' runs at normal priority: {}", e.name, e.affinity_note);
+    } else if (!e.affinity_note.empty()) {
+      spdlog::warn("executor '{}': {}", e.name, e.affinity_note);
+    }
+  }
+
+  for (auto& source : sources_) {
+    if (Status s = source->Start(&pipeline); !s.ok()) {
+      spdlog::error("source '{}' did not start: {}", source->name(), s.ToString());
+    }
+  }
+
+  SystemdNotifier notifier;
+  notifier.Ready("running " + run.mode);
+  spdlog::info("cairnd '{}' running ({}{})", run.robot, run.mode,
+               deterministic ? ", deterministic" : "");
+
+  const bool finite = options_.source == SourceKind::kReplay;
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGTERM);
+  sigaddset(&set, SIGINT);
+  auto next_status = std::chrono::steady_clock::now();
+  const auto status_period = std::chrono::duration<double>(options_.daemon.status_interval);
+  while (true) {
+    timespec timeout{0, 50 * 1000 * 1000};
+    const int sig = sigtimedwait(&set, nullptr, &timeout);
+    if (sig == SIGTERM || sig == SIGINT) {
+      run.stop_reason = "signal";
+      spdlog::info("{} received: stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+      break;
+    }
+    if (finite) {
+      bool all_done = true;
+      for (const auto& s : sources_) all_done = all_done && s->finished();
+      if (all_done) {
+        run.stop_reason = "end_of_data";
+        break;
+      }
+    }
+    notifier.KeepAlive();
+    if (std::chrono::steady_clock::now() >= next_status) {
+      next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(status_period);
+      const std::string status = "imu " + std::to_string(pipeline.consumed_imu()) + ", stereo " +
+                                 std::to_string(pipeline.consumed_stereo()) + ", dropped " +
+                                 std::to_string(pipeline.total_dropped());
+      notifier.Status(status);
+      spdlog::debug("{}", status);
+    }
+  }
+
+  notifier.Stopping();
+  for (auto& s : sources_) s->Stop();
+  pipeline.StopAndDrain();
+  run.complete = finite && run.stop_reason == "end_of_data";
+  run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  if (dataset_) {
+    run.replay = ReplayInfo{options_.replay.dataset, PacingName(options_.replay.pacing),
+                            deterministic, dataset_->stereo().size(), dataset_->unpaired_left(),
+                            dataset_->unpaired_right(), dataset_->imu().size()};
+  }
+  if (Status s = WriteOutputs(run, pipeline); !s.ok()) {
+    spdlog::error("writing outputs failed: {}", s.ToString());
+    return 1;
+  }
+  spdlog::info("{}: imu {} samples, stereo {} frames, wheel {} samples, {} dropped, {} faults -> {}/summary.json",
+               run.stop_reason, pipeline.imu_stats().count(), pipeline.stereo_stats().count(),
+               pipeline.wheel_stats().count(), pipeline.total_dropped(),
+               pipeline.fault_report().total, options_.output.dir);
+  return 0;
+}
+
+Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
+  const std::string dir = options_.output.dir;
+  CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/config.yaml", "# effective configuration of this run (from " +
+                                                                      config_path_ + ")\n" +
+                                                                      OptionsYamlWriter::Write(options_)));
+  CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/diagnostics.json", BuildDiagnosticsJson(run, pipeline)));
+  // Last: its presence means the run's outputs are complete.
+  return WriteFileAtomically(dir + "/summary.json", BuildSummaryJson(run, pipeline));
+}
+
+}  // namespace cairn

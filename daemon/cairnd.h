@@ -1,0 +1,37 @@
+#pragma once
+// The daemon process: builds the sources a configuration asks for, runs the pipeline on its
+// executors, reacts to SIGTERM/SIGINT and end of data, and writes the run's outputs.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "daemon/cairnd_options.h"
+#include "drivers/euroc_dataset.h"
+#include "hal/sensor_source_interface.h"
+
+namespace cairn {
+
+class Cairnd {
+ public:
+  Cairnd(CairndOptions options, std::string config_path);
+
+  // Opens every source and validates its data. Nothing is written before this succeeds.
+  Status Prepare();
+  // Runs until end of data or a termination signal; returns the process exit code. The caller
+  // must have blocked SIGTERM and SIGINT in all threads (BlockTerminationSignals) first.
+  int Run();
+
+  static void BlockTerminationSignals();
+
+ private:
+  Status WriteOutputs(const struct RunInfo& run, const class Pipeline& pipeline);
+
+  CairndOptions options_;
+  std::string config_path_;
+  std::optional<EurocDataset> dataset_;
+  std::vector<std::unique_ptr<SensorSourceInterface>> sources_;
+};
+
+}  // namespace cairn

@@ -1,0 +1,17 @@
+#include "daemon/cairnd_config.h"
+
+#include "daemon/yaml_options_reader.h"
+
+namespace cairn {
+
+Expected<CairndOptions> LoadCairndOptions(const std::string& path,
+                                          const std::vector<std::string>& overrides) {
+  auto doc = LoadYamlWithOverrides(path, overrides);
+  if (!doc.ok()) return doc.status();
+  CairndOptions options;
+  YamlOptionsReader reader(doc->root, path, doc->overridden_keys);
+  CAIRN_RETURN_IF_ERROR(reader.Read(options));
+  return options;
+}
+
+}  // namespace cairn

@@ -1,0 +1,60 @@
+#pragma once
+// Scheduling of one executor (a thread or a pool): the single place where threads, priorities,
+// CPU affinity and queue depths are declared is CairndOptions::executors and ::queues below, with
+// the defaults every robot profile starts from in configs/.
+
+#include <vector>
+
+#include "hal/options_visitor.h"
+
+namespace cairn {
+
+struct ExecutorOptions {
+  // SCHED_FIFO at `priority` (1..99), with the process memory locked. Where the system does not
+  // allow it the executor runs at normal priority and the daemon logs one warning.
+  bool realtime = false;
+  int64_t priority = 0;
+  // Nice value for normal-policy executors (-20 most favoured .. 19 least).
+  int64_t nice = 0;
+  // CPUs the threads may run on; empty = any.
+  std::vector<double> cpus;
+
+  void Visit(OptionsVisitor& v) {
+    v.Flag("realtime", realtime);
+    v.Integer("priority", priority, 0, 99, "");
+    v.Integer("nice", nice, -20, 19, "");
+    v.Numbers("cpus", cpus, 0, 1024, 0, 1023, "cpu index");
+  }
+  Status Validate() const {
+    if (realtime && priority < 1) return InvalidArgumentError("a realtime executor needs priority 1..99");
+    for (double c : cpus) {
+      if (c != static_cast<double>(static_cast<int>(c))) return InvalidArgumentError("cpus must be whole numbers");
+    }
+    return Status::Ok();
+  }
+};
+
+struct ExecutorsOptions {
+  ExecutorOptions estimation;  // the hard-real-time filter thread
+  ExecutorOptions stereo;      // rectification, SGM, depth
+
+  void Visit(OptionsVisitor& v) {
+    v.Section("estimation", estimation);
+    v.Section("stereo", stereo);
+  }
+};
+
+// Bounded queues between stages. What a full queue drops is counted and reported.
+struct QueueOptions {
+  int64_t imu = 2048;
+  int64_t wheel_odometry = 512;
+  int64_t stereo = 4;
+
+  void Visit(OptionsVisitor& v) {
+    v.Integer("imu", imu, 2, 1 << 20, "samples");
+    v.Integer("wheel_odometry", wheel_odometry, 2, 1 << 20, "samples");
+    v.Integer("stereo", stereo, 2, 1024, "frames");
+  }
+};
+
+}  // namespace cairn

@@ -1,0 +1,114 @@
+#pragma once
+// The daemon's data path: the SensorSink that every source publishes into, the bounded queues,
+// and the stage loops running on their executors. In live operation a publisher never waits (a
+// full queue drops and counts); in deterministic replay every sample is consumed by its stage
+// before the publisher returns, so a run's results do not depend on thread timing.
+
+#include <array>
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "daemon/executor.h"
+#include "daemon/executor_options.h"
+#include "daemon/sensor_stream_stats.h"
+#include "daemon/spsc_queue.h"
+#include "hal/sensor_sink.h"
+
+namespace cairn {
+
+struct PipelineRates {
+  double imu_hz = 0.0;      // nominal rates for gap detection; 0 disables it
+  double camera_hz = 0.0;
+  double wheel_hz = 0.0;
+};
+
+struct QueueReport {
+  std::string name;
+  size_t capacity = 0;
+  uint64_t pushed = 0;
+  uint64_t dropped = 0;
+  uint64_t high_water = 0;
+};
+
+struct FaultReport {
+  std::map<std::string, std::map<std::string, uint64_t>> counts;  // device -> kind -> count
+  uint64_t total = 0;
+  std::vector<std::string> first_messages;                         // the first few, verbatim
+};
+
+struct StereoStageReport {
+  uint64_t frame_counter_gaps = 0;  // frames the device numbered but we never saw
+  int width = 0;
+  int height = 0;
+  uint64_t size_changes = 0;
+};
+
+class Pipeline final : public SensorSink {
+ public:
+  Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues, PipelineRates rates,
+           bool deterministic);
+  ~Pipeline() override;
+
+  // Starts the stage threads.
+  void Start();
+  // Lets the stages consume what is queued, then joins them. Publishing must have stopped.
+  void StopAndDrain();
+
+  void OnImu(const ImuSample& sample) override;
+  void OnStereo(const StereoFrame& frame) override;
+  void OnWheelOdometry(const WheelOdometrySample& sample) override;
+  void OnTrigger(const TriggerEvent& event) override;
+  void OnDeviceFault(const DeviceFault& fault) override;
+
+  // Valid after StopAndDrain().
+  const SensorStreamStats& imu_stats() const { return imu_stats_; }
+  const SensorStreamStats& stereo_stats() const { return stereo_stats_; }
+  const SensorStreamStats& wheel_stats() const { return wheel_stats_; }
+  const SensorStreamStats& trigger_stats() const { return trigger_stats_; }
+  const StereoStageReport& stereo_report() const { return stereo_report_; }
+  std::vector<QueueReport> queue_reports() const;
+  std::vector<ExecutorReport> executor_reports() const;
+  FaultReport fault_report() const;
+
+  // Live progress (any thread).
+  uint64_t consumed_imu() const { return imu_queue_.popped(); }
+  uint64_t consumed_stereo() const { return stereo_queue_.popped(); }
+  uint64_t total_dropped() const;
+
+ private:
+  template <class T>
+  void Publish(SpscQueue<T>& queue, const T& item, WorkSignal& signal);
+  void EstimationLoop(std::stop_token stop);
+  void StereoLoop(std::stop_token stop);
+
+  const bool deterministic_;
+  WorkSignal estimation_signal_;
+  WorkSignal stereo_signal_;
+  WorkSignal consumed_signal_;  // deterministic mode: the publisher waits on this
+  SpscQueue<ImuSample> imu_queue_;
+  SpscQueue<WheelOdometrySample> wheel_queue_;
+  SpscQueue<TriggerEvent> trigger_queue_;
+  SpscQueue<StereoFrame> stereo_queue_;
+
+  Executor estimation_;
+  Executor stereo_;
+
+  // Owned by the estimation thread until joined.
+  SensorStreamStats imu_stats_;
+  SensorStreamStats wheel_stats_;
+  SensorStreamStats trigger_stats_;
+  // Owned by the stereo thread until joined.
+  SensorStreamStats stereo_stats_;
+  StereoStageReport stereo_report_;
+  uint64_t last_frame_counter_ = 0;
+
+  mutable std::mutex fault_mutex_;
+  FaultReport faults_;
+  bool started_ = false;
+};
+
+}  // namespace cairn

@@ -1,0 +1,109 @@
+#include "daemon/run_summary.h"
+
+#include "daemon/json_writer.h"
+
+namespace cairn {
+namespace {
+
+void WriteStream(JsonWriter& j, std::string_view name, const SensorStreamStats& s) {
+  j.Key(name).BeginObject();
+  j.Field("count", s.count());
+  if (s.count() > 0) {
+    j.Field("first_time_ns", s.first().nanoseconds());
+    j.Field("last_time_ns", s.last().nanoseconds());
+  }
+  j.Field("duration_s", s.duration());
+  j.Field("mean_rate_hz", s.mean_rate_hz());
+  if (s.nominal_rate_hz() > 0.0) j.Field("nominal_rate_hz", s.nominal_rate_hz());
+  j.Field("max_gap_s", s.max_gap());
+  j.Field("gaps", s.gaps());
+  j.Field("out_of_order", s.out_of_order());
+  j.Field("duplicates", s.duplicates());
+  j.EndObject();
+}
+
+}  // namespace
+
+std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
+  JsonWriter j;
+  j.BeginObject();
+  j.Field("robot", run.robot);
+  j.Field("mode", run.mode);
+  j.Field("stop_reason", run.stop_reason);
+  j.Field("complete", run.complete);
+  if (run.replay) {
+    const ReplayInfo& r = *run.replay;
+    j.Key("replay").BeginObject();
+    j.Field("dataset", r.dataset);
+    j.Field("pacing", r.pacing);
+    j.Field("deterministic", r.deterministic);
+    j.Field("imu_samples", r.imu_samples);
+    j.Field("stereo_pairs", r.stereo_pairs);
+    j.Field("unpaired_left", r.unpaired_left);
+    j.Field("unpaired_right", r.unpaired_right);
+    j.EndObject();
+  }
+  j.Key("streams").BeginObject();
+  WriteStream(j, "imu", p.imu_stats());
+  WriteStream(j, "stereo", p.stereo_stats());
+  WriteStream(j, "wheel_odometry", p.wheel_stats());
+  WriteStream(j, "trigger", p.trigger_stats());
+  j.EndObject();
+  const StereoStageReport& sr = p.stereo_report();
+  j.Key("stereo").BeginObject();
+  j.Field("width", sr.width).Field("height", sr.height);
+  j.Field("frame_counter_gaps", sr.frame_counter_gaps);
+  j.Field("size_changes", sr.size_changes);
+  j.EndObject();
+  j.Key("dropped").BeginObject();
+  for (const QueueReport& q : p.queue_reports()) j.Field(q.name, q.dropped);
+  j.EndObject();
+  const FaultReport f = p.fault_report();
+  j.Key("faults").BeginObject();
+  j.Field("total", f.total);
+  j.Key("by_device").BeginObject();
+  for (const auto& [device, kinds] : f.counts) {
+    j.Key(device).BeginObject();
+    for (const auto& [kind, n] : kinds) j.Field(kind, n);
+    j.EndObject();
+  }
+  j.EndObject();
+  j.Key("first_messages").BeginArray();
+  for (const auto& m : f.first_messages) j.String(m);
+  j.EndArray();
+  j.EndObject();
+  j.EndObject();
+  return j.str();
+}
+
+std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
+  JsonWriter j;
+  j.BeginObject();
+  j.Field("wall_time_s", run.wall_time);
+  j.Field("memory_locked", run.memory_locked);
+  if (!run.memory_lock_note.empty()) j.Field("memory_lock_note", run.memory_lock_note);
+  j.Key("executors").BeginArray();
+  for (const ExecutorReport& e : p.executor_reports()) {
+    j.BeginObject();
+    j.Field("name", e.name);
+    j.Field("realtime_requested", e.realtime_requested);
+    j.Field("realtime_granted", e.realtime_granted);
+    j.Field("policy", e.policy);
+    j.Field("priority", e.priority);
+    if (!e.affinity_note.empty()) j.Field("note", e.affinity_note);
+    j.EndObject();
+  }
+  j.EndArray();
+  j.Key("queues").BeginArray();
+  for (const QueueReport& q : p.queue_reports()) {
+    j.BeginObject();
+    j.Field("name", q.name).Field("capacity", q.capacity).Field("pushed", q.pushed);
+    j.Field("dropped", q.dropped).Field("high_water", q.high_water);
+    j.EndObject();
+  }
+  j.EndArray();
+  j.EndObject();
+  return j.str();
+}
+
+}  // namespace cairn

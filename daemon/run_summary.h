@@ -1,0 +1,37 @@
+#pragma once
+// What a run leaves behind. summary.json holds only what follows from the data (so deterministic
+// replays produce identical files); diagnostics.json holds what depends on the host and timing
+// (scheduling granted, queue high-water marks, wall time).
+
+#include <optional>
+#include <string>
+
+#include "daemon/pipeline.h"
+
+namespace cairn {
+
+struct ReplayInfo {
+  std::string dataset;
+  std::string pacing;
+  bool deterministic = false;
+  size_t stereo_pairs = 0;
+  int unpaired_left = 0;
+  int unpaired_right = 0;
+  size_t imu_samples = 0;
+};
+
+struct RunInfo {
+  std::string robot;
+  std::string mode;         // "replay" or "live"
+  std::string stop_reason;  // "end_of_data" or "signal"
+  bool complete = false;    // all input consumed (replay) 
+  std::optional<ReplayInfo> replay;
+  double wall_time = 0.0;   // s
+  bool memory_locked = false;
+  std::string memory_lock_note;
+};
+
+std::string BuildSummaryJson(const RunInfo& run, const Pipeline& pipeline);
+std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& pipeline);
+
+}  // namespace cairn

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package cairn needs to build, test and run. Idempotent: it asks apt only
+# for what is missing. Works as root or through sudo.
+set -euo pipefail
+
+packages=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git
+  # libraries
+  libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # tools used by tests and scripts
+  systemd iproute2 can-utils util-linux python3
+)
+if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
+  packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+sudo=""
+if [[ $(id -u) -ne 0 ]]; then sudo="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

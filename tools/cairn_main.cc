@@ -1,0 +1,50 @@
+// cairn: offline tools around the cairnd daemon (stereo, evaluation, benchmarks, graphs, ...).
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+#include "tools/cairn_command.h"
+#include "tools/commands.h"
+
+namespace cairn::tools {
+namespace {
+
+constexpr auto kCommands = std::to_array<Command>({
+    {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
+    {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
+});
+
+void PrintHelp() {
+  std::printf("usage: cairn COMMAND [ARGS...]\n\ncommands:\n");
+  for (const Command& c : kCommands) {
+    std::printf("  %-16s %.*s\n", std::string(c.name).c_str(), static_cast<int>(c.summary.size()),
+                c.summary.data());
+  }
+}
+
+}  // namespace
+}  // namespace cairn::tools
+
+int main(int argc, char** argv) {
+  using cairn::tools::kCommands;
+  if (argc < 2 || std::string(argv[1]) == "help" || std::string(argv[1]) == "--help") {
+    cairn::tools::PrintHelp();
+    return argc < 2 ? 2 : 0;
+  }
+  // Two-word commands ("bench stereo") take precedence over one-word ones ("stereo").
+  for (int words = 2; words >= 1; --words) {
+    if (argc < 1 + words) continue;
+    std::string name = argv[1];
+    if (words == 2) name += std::string(" ") + argv[2];
+    for (const auto& c : kCommands) {
+      if (c.name == name) {
+        cairn::tools::CommandArgs args{c.name, std::span<char* const>(argv + 1 + words,
+                                                                    static_cast<size_t>(argc - 1 - words))};
+        return c.run(args);
+      }
+    }
+  }
+  std::fprintf(stderr, "cairn: unknown command '%s' (see 'cairn help')\n", argv[1]);
+  return 2;
+}

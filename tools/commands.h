@@ -1,0 +1,10 @@
+#pragma once
+
+#include "tools/cairn_command.h"
+
+namespace cairn::tools {
+
+int RunConfigCheck(const CommandArgs& args);
+int RunConfigDoc(const CommandArgs& args);
+
+}  // namespace cairn::tools
