@@ -28,7 +28,7 @@ TEST(So3Test, ExpMatchesEigenAngleAxis) {
 }
 
 TEST(So3Test, RightJacobianLinearizesExp) {
-  for (const Eigen::Vector3d w : {Eigen::Vector3d(1e-8, 0, 0), Eigen::Vector3d(0.4, -0.2, 1.3)}) {
+  for (const Eigen::Vector3d& w : {Eigen::Vector3d(1e-8, 0, 0), Eigen::Vector3d(0.4, -0.2, 1.3)}) {
     const Eigen::Matrix3d Jr = so3::RightJacobian(w);
     EXPECT_LT((Jr * so3::RightJacobianInverse(w) - Eigen::Matrix3d::Identity()).norm(), 1e-9);
     const Eigen::Vector3d dw(1e-6, -2e-6, 0.5e-6);

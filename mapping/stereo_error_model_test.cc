@@ -72,9 +72,12 @@ TEST(StereoErrorModelTest, DistanceErrorAgreesWithNumericPropagation) {
 
 TEST(StereoErrorModelTest, DistanceErrorGrowsWithRange) {
   const StereoErrorModel m(1080.0, 0.09, 0.5);
-  const Eigen::Vector3d step(0.0, 0.1, 0.0);
   const Eigen::Vector3d near(0.0, 0.5, 2.0), far(0.0, 0.5, 6.0);
-  EXPECT_GT(m.DistanceError(far, far + step), 4.0 * m.DistanceError(near, near + step));
+  // A step across the line of sight scales with depth (like eq. 5.2b), one along it with the
+  // square of the depth (like eq. 5.2c): three times farther is three and nine times worse.
+  const Eigen::Vector3d across(0.0, 0.1, 0.0), along(0.0, 0.0, 0.1);
+  EXPECT_NEAR(m.DistanceError(far, far + across) / m.DistanceError(near, near + across), 3.0, 0.05);
+  EXPECT_NEAR(m.DistanceError(far, far + along) / m.DistanceError(near, near + along), 9.0, 0.5);
 }
 
 }  // namespace
