@@ -39,10 +39,15 @@ function(cairn_test name)
   if("concurrency" IN_LIST ARG_LABELS)
     add_dependencies(concurrency_tests ${name})
   endif()
+  set(labels unit)
+  if(ARG_LABELS)
+    set(labels ${ARG_LABELS})
+  endif()
+  string(REPLACE ";" "\\;" labels "${labels}")
   gtest_discover_tests(${name}
     DISCOVERY_MODE PRE_TEST
     PROPERTIES
-      LABELS "${ARG_LABELS}"
+      LABELS "${labels}"
       TIMEOUT ${ARG_TIMEOUT}
       ENVIRONMENT "CAIRN_DATA_DIR=${CAIRN_DATA_DIR};CAIRN_SOURCE_DIR=${PROJECT_SOURCE_DIR};CAIRN_BINARY_DIR=${PROJECT_BINARY_DIR}")
 endfunction()
