@@ -35,6 +35,11 @@ function(cairn_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR})
+  # Fallbacks for running a test binary by hand; ctest also sets CAIRN_DATA_DIR.
+  target_compile_definitions(${name} PRIVATE
+    CAIRN_TEST_DATA_DIR="${CAIRN_DATA_DIR}"
+    CAIRN_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+    CAIRN_TEST_BINARY_DIR="${PROJECT_BINARY_DIR}")
   cairn_warnings(${name})
   if("concurrency" IN_LIST ARG_LABELS)
     add_dependencies(concurrency_tests ${name})
@@ -49,7 +54,7 @@ function(cairn_test name)
     PROPERTIES
       LABELS "${labels}"
       TIMEOUT ${ARG_TIMEOUT}
-      ENVIRONMENT "CAIRN_DATA_DIR=${CAIRN_DATA_DIR};CAIRN_SOURCE_DIR=${PROJECT_SOURCE_DIR};CAIRN_BINARY_DIR=${PROJECT_BINARY_DIR}")
+      ENVIRONMENT "CAIRN_DATA_DIR=${CAIRN_DATA_DIR}")
 endfunction()
 
 # Tests labelled "concurrency" also run under ThreadSanitizer (the tsan preset builds only them).

@@ -29,7 +29,9 @@ Expected<int> SocketCanWheelDriver::OpenSocket(const CanWheelOptions& options) {
     return InvalidArgumentError("CAN interface name '" + options.interface + "' is too long");
   }
   const int fd = socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
-  if (fd < 0) return UnavailableError(std::string("socket(PF_CAN): ") + std::strerror(errno));
+  if (fd < 0) {
+    return UnavailableError("CAN interface '" + options.interface + "': socket(PF_CAN): " + std::strerror(errno));
+  }
   ifreq ifr{};
   std::strncpy(ifr.ifr_name, options.interface.c_str(), IFNAMSIZ - 1);
   if (ioctl(fd, SIOCGIFINDEX, &ifr) < 0) {
