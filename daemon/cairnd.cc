@@ -75,7 +75,6 @@ int Cairnd::Run() {
   const ExecutorsOptions& ex = options_.executors;
   if (ex.estimation.realtime || ex.stereo.realtime) {
     run.memory_locked = Executor::LockProcessMemory(&run.memory_lock_note);
-    if (!run.memory_locked) spdlog::warn("memory not locked ({}); page faults may delay real-time threads", run.memory_lock_note);
   }
 
   PipelineRates rates;
@@ -86,13 +85,18 @@ int Cairnd::Run() {
   const bool deterministic = options_.source == SourceKind::kReplay && options_.replay.deterministic;
   Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
   pipeline.Start();
-  for (const ExecutorReport& e : pipeline.executor_reports()) {
-    if (e.realtime_requested && !e.realtime_granted) {
-      spdlog::warn("executor '{}' runs at normal priority: {}", e.name, e.affinity_note);
-    } else if (!e.affinity_note.empty()) {
-      spdlog::warn("executor '{}': {}", e.name, e.affinity_note);
-    }
+  // Everything the system refused of the requested scheduling, in one warning.
+  std::string refused;
+  if ((ex.estimation.realtime || ex.stereo.realtime) && !run.memory_locked) {
+    refused = "memory not locked (" + run.memory_lock_note + ")";
   }
+  for (const ExecutorReport& e : pipeline.executor_reports()) {
+    if (e.affinity_note.empty()) continue;
+    refused += (refused.empty() ? "" : "; ") + e.name +
+               (e.realtime_requested && !e.realtime_granted ? " runs at normal priority: " : ": ") +
+               e.affinity_note;
+  }
+  if (!refused.empty()) spdlog::warn("real-time scheduling degraded: {}", refused);
 
   for (auto& source : sources_) {
     if (Status s = source->Start(&pipeline); !s.ok()) {
