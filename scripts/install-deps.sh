@@ -10,7 +10,7 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # tools used by tests and scripts
-  systemd iproute2 can-utils util-linux python3
+  systemd iproute2 can-utils util-linux file
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)
