@@ -7,7 +7,11 @@
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <poll.h>
+
+#include <atomic>
 #include <filesystem>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -28,6 +32,19 @@ TEST(CairndSystemdNotifyTest, ReadyStatusWatchdogStopping) {
   std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", path.c_str());
   ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
 
+  // Like systemd, read as messages arrive: a unix datagram queue holds only a few, and a full one
+  // blocks the sender.
+  std::vector<std::string> messages;
+  std::atomic<bool> stop{false};
+  std::thread reader([&] {
+    char buf[4096];
+    while (!stop.load()) {
+      pollfd p{fd, POLLIN, 0};
+      if (poll(&p, 1, 20) <= 0) continue;
+      for (ssize_t n; (n = recv(fd, buf, sizeof(buf), 0)) > 0;) messages.emplace_back(buf, static_cast<size_t>(n));
+    }
+  });
+
   testing::ProcessOptions po;
   po.env = {"NOTIFY_SOCKET=" + path, "WATCHDOG_USEC=200000"};
   po.signal = SIGTERM;
@@ -38,12 +55,10 @@ TEST(CairndSystemdNotifyTest, ReadyStatusWatchdogStopping) {
        "--replay", testing::EurocMicro(), "--out", dir + "/out", "--set", "replay.pacing=realtime",
        "--set", "daemon.status_interval=0.2"},
       po);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-
-  std::vector<std::string> messages;
-  char buf[4096];
-  for (ssize_t n; (n = recv(fd, buf, sizeof(buf), 0)) > 0;) messages.emplace_back(buf, static_cast<size_t>(n));
+  stop.store(true);
+  reader.join();
   close(fd);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
   ASSERT_FALSE(messages.empty());
   EXPECT_EQ(messages.front().rfind("READY=1", 0), 0u) << messages.front();
   EXPECT_EQ(messages.back(), "STOPPING=1");
