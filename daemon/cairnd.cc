@@ -13,6 +13,7 @@
 #include "daemon/run_summary.h"
 #include "daemon/systemd_notifier.h"
 #include "drivers/euroc_replay.h"
+#include "drivers/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
 
 namespace cairn {
@@ -45,6 +46,20 @@ Status Cairnd::Prepare() {
     if (options_.replay.dataset.empty()) {
       return InvalidArgumentError(config_path_ + ": replay.dataset is empty; give a dataset with --replay DIR");
     }
+    if (McapReplay::IsRecording(options_.replay.dataset)) {
+      auto files = McapReplay::FindRecordings(options_.replay.dataset);
+      if (!files.ok()) return files.status();
+      const auto out = std::filesystem::weakly_canonical(options_.output.dir);
+      for (const std::string& f : *files) {
+        if (options_.recording.enabled && std::filesystem::weakly_canonical(f).parent_path() == out) {
+          return InvalidArgumentError(f + ": replaying a recording into its own folder with recording "
+                                          "enabled would overwrite it; choose another --out");
+        }
+      }
+      sources_.push_back(std::make_unique<McapReplay>(*files, options_.replay));
+    }
+  }
+  if (options_.source == SourceKind::kReplay && sources_.empty()) {
     auto ds = EurocDataset::Open(options_.replay.dataset);
     if (!ds.ok()) return ds.status();
     if (ds->imu().empty() && ds->stereo().empty()) {
@@ -73,7 +88,7 @@ int Cairnd::Run() {
   run.mode = options_.source == SourceKind::kReplay ? "replay" : "live";
 
   const ExecutorsOptions& ex = options_.executors;
-  if (ex.estimation.realtime || ex.stereo.realtime) {
+  if (ex.estimation.realtime || ex.stereo.realtime || ex.telemetry.realtime) {
     run.memory_locked = Executor::LockProcessMemory(&run.memory_lock_note);
   }
 
@@ -84,10 +99,17 @@ int Cairnd::Run() {
   }
   const bool deterministic = options_.source == SourceKind::kReplay && options_.replay.deterministic;
   Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
+  std::unique_ptr<RecordingStage> recording;
+  if (options_.recording.enabled) {
+    recording = std::make_unique<RecordingStage>(options_.output.dir, options_.recording,
+                                                 options_.executors.telemetry, deterministic);
+    recording->Start();
+    pipeline.SetRecorder(recording.get());
+  }
   pipeline.Start();
   // Everything the system refused of the requested scheduling, in one warning.
   std::string refused;
-  if ((ex.estimation.realtime || ex.stereo.realtime) && !run.memory_locked) {
+  if ((ex.estimation.realtime || ex.stereo.realtime || ex.telemetry.realtime) && !run.memory_locked) {
     refused = "memory not locked (" + run.memory_lock_note + ")";
   }
   for (const ExecutorReport& e : pipeline.executor_reports()) {
@@ -146,6 +168,11 @@ int Cairnd::Run() {
   notifier.Stopping();
   for (auto& s : sources_) s->Stop();
   pipeline.StopAndDrain();
+  if (recording) {
+    recording->StopAndDrain();
+    run.recording = recording->report();
+    run.recording_dropped = recording->dropped();
+  }
   run.complete = finite && run.stop_reason == "end_of_data";
   run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (dataset_) {

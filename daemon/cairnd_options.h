@@ -6,6 +6,7 @@
 #include <string>
 
 #include "daemon/executor_options.h"
+#include "daemon/recording_options.h"
 #include "drivers/can_wheel_options.h"
 #include "drivers/replay_options.h"
 #include "hal/options_visitor.h"
@@ -62,6 +63,7 @@ struct CairndOptions {
   QueueOptions queues;
   DaemonOptions daemon;
   OutputOptions output;
+  RecordingOptions recording;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -72,6 +74,7 @@ struct CairndOptions {
     v.Section("queues", queues);
     v.Section("daemon", daemon);
     v.Section("output", output);
+    v.Section("recording", recording);
   }
 };
 

@@ -37,10 +37,12 @@ struct ExecutorOptions {
 struct ExecutorsOptions {
   ExecutorOptions estimation;  // the hard-real-time filter thread
   ExecutorOptions stereo;      // rectification, SGM, depth
+  ExecutorOptions telemetry;   // recording (and later the live stream)
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
     v.Section("stereo", stereo);
+    v.Section("telemetry", telemetry);
   }
 };
 

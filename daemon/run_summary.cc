@@ -2,6 +2,8 @@
 
 #include "daemon/json_writer.h"
 
+#include <filesystem>
+
 namespace cairn {
 namespace {
 
@@ -58,6 +60,19 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
   j.Key("dropped").BeginObject();
   for (const QueueReport& q : p.queue_reports()) j.Field(q.name, q.dropped);
   j.EndObject();
+  if (run.recording) {
+    j.Key("recording").BeginObject();
+    j.Key("files").BeginArray();
+    for (const auto& f : run.recording->files) j.String(std::filesystem::path(f).filename().string());
+    j.EndArray();
+    j.Key("messages").BeginObject();
+    for (const auto& [topic, n] : run.recording->messages) j.Field(topic, n);
+    j.EndObject();
+    j.Field("bytes", run.recording->bytes);
+    j.Field("dropped", run.recording_dropped);
+    j.Field("write_errors", run.recording->write_errors);
+    j.EndObject();
+  }
   const FaultReport f = p.fault_report();
   j.Key("faults").BeginObject();
   j.Field("total", f.total);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "daemon/pipeline.h"
+#include "daemon/mcap_recorder.h"
 
 namespace cairn {
 
@@ -26,6 +27,8 @@ struct RunInfo {
   std::string stop_reason;  // "end_of_data" or "signal"
   bool complete = false;    // all input consumed (replay) 
   std::optional<ReplayInfo> replay;
+  std::optional<RecordingReport> recording;
+  uint64_t recording_dropped = 0;
   double wall_time = 0.0;   // s
   bool memory_locked = false;
   std::string memory_lock_note;

@@ -9,7 +9,8 @@ namespace cairn {
 enum class ReplayPacing { kRealTime, kScaled, kFastAsPossible };
 
 struct ReplayOptions {
-  // An EuRoC/ASL folder (the one holding mav0/). Empty means "given with --replay".
+  // An EuRoC/ASL folder (the one holding mav0/), or a cairnd recording (an .mcap file or a folder
+  // of recording-NNN.mcap). Empty means "given with --replay".
   std::string dataset;
   ReplayPacing pacing = ReplayPacing::kFastAsPossible;
   // Playback speed for `scaled` pacing: 2 plays twice as fast as recorded.

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "daemon/json_writer.h"
-#include "daemon/mcap/mcap_reader.h"
+#include "drivers/mcap/mcap_reader.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/mcap/mcap_writer.h"
+#include "drivers/mcap/mcap_writer.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"

@@ -1,4 +1,4 @@
-#include "daemon/mcap/crc32.h"
+#include "drivers/mcap/crc32.h"
 
 #include <string>
 

@@ -65,6 +65,7 @@ struct McapScanResult {
   uint64_t chunks = 0;
   bool truncated = false;     // the file ends inside a record (e.g. after a crash)
   bool reached_data_end = false;
+  bool stopped = false;
 };
 
 class McapReader {
@@ -74,8 +75,10 @@ class McapReader {
   explicit McapReader(std::string path) : path_(std::move(path)) {}
 
   // Reads the data section in file order. Schemas and channels seen so far are available through
-  // channels()/schemas() during and after the scan.
-  Expected<McapScanResult> Scan(const MessageCallback& on_message);
+  // channels()/schemas() during and after the scan. `stop`, when given, is asked after every
+  // message; returning true ends the scan early (result.stopped).
+  Expected<McapScanResult> Scan(const MessageCallback& on_message,
+                                const std::function<bool()>& stop = {});
   // Reads the summary section through the footer (fails on files without one, e.g. truncated).
   Expected<McapSummary> ReadSummary() const;
 
@@ -85,6 +88,7 @@ class McapReader {
  private:
   Status HandleRecord(uint8_t op, std::span<const uint8_t> body, const MessageCallback& cb,
                       McapScanResult* result, uint64_t at);
+  std::function<bool()> stop_;
 
   std::string path_;
   std::map<uint16_t, McapChannel> channels_;

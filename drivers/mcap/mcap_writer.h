@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "daemon/mcap/byte_writer.h"
-#include "daemon/mcap/chunk_codec.h"
-#include "daemon/mcap/crc32.h"
+#include "drivers/mcap/byte_writer.h"
+#include "drivers/mcap/chunk_codec.h"
+#include "drivers/mcap/crc32.h"
 #include "hal/status.h"
 
 namespace cairn {

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/mcap/mcap_reader.h"
-#include "daemon/mcap/mcap_writer.h"
+#include "drivers/mcap/mcap_reader.h"
+#include "drivers/mcap/mcap_writer.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {

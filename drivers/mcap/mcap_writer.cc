@@ -1,4 +1,4 @@
-#include "daemon/mcap/mcap_writer.h"
+#include "drivers/mcap/mcap_writer.h"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,12 +1,12 @@
-#include "daemon/mcap/mcap_reader.h"
+#include "drivers/mcap/mcap_reader.h"
 
 #include <cerrno>
 #include <cstring>
 #include <memory>
 
-#include "daemon/mcap/byte_reader.h"
-#include "daemon/mcap/chunk_codec.h"
-#include "daemon/mcap/crc32.h"
+#include "drivers/mcap/byte_reader.h"
+#include "drivers/mcap/chunk_codec.h"
+#include "drivers/mcap/crc32.h"
 
 namespace cairn {
 namespace {
@@ -76,6 +76,7 @@ Status McapReader::HandleRecord(uint8_t op, std::span<const uint8_t> body,
       }
       ++result->messages;
       if (cb) cb(it->second, m);
+      if (stop_ && stop_()) result->stopped = true;
       return Status::Ok();
     }
     case 0x06: {
@@ -102,6 +103,7 @@ Status McapReader::HandleRecord(uint8_t op, std::span<const uint8_t> body,
         const auto inner_body = inner.Take(inner.U64());
         if (inner.failed()) return DataLossError(At(path_, at) + ": chunk record at " + std::to_string(inner_at) + " overruns the chunk");
         CAIRN_RETURN_IF_ERROR(HandleRecord(inner_op, inner_body, cb, result, at));
+        if (result->stopped) break;
       }
       ++result->chunks;
       chunk_buffer_.swap(records);
@@ -112,7 +114,9 @@ Status McapReader::HandleRecord(uint8_t op, std::span<const uint8_t> body,
   }
 }
 
-Expected<McapScanResult> McapReader::Scan(const MessageCallback& on_message) {
+Expected<McapScanResult> McapReader::Scan(const MessageCallback& on_message,
+                                          const std::function<bool()>& stop) {
+  stop_ = stop;
   File f(std::fopen(path_.c_str(), "rb"));
   if (!f) return NotFoundError(path_ + ": cannot open: " + std::strerror(errno));
   uint8_t magic[8];
@@ -150,6 +154,7 @@ Expected<McapScanResult> McapReader::Scan(const MessageCallback& on_message) {
       break;
     }
     CAIRN_RETURN_IF_ERROR(HandleRecord(op, body, on_message, &result, offset));
+    if (result.stopped) break;
     offset += 9 + len;
   }
   return result;

@@ -1,4 +1,4 @@
-#include "daemon/mcap/byte_writer.h"
+#include "drivers/mcap/byte_writer.h"
 
 namespace cairn {
 

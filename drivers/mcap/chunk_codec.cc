@@ -1,4 +1,4 @@
-#include "daemon/mcap/chunk_codec.h"
+#include "drivers/mcap/chunk_codec.h"
 
 #include <lz4frame.h>
 #include <zstd.h>
