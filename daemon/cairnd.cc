@@ -99,12 +99,22 @@ int Cairnd::Run() {
   }
   const bool deterministic = options_.source == SourceKind::kReplay && options_.replay.deterministic;
   Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
-  std::unique_ptr<RecordingStage> recording;
-  if (options_.recording.enabled) {
-    recording = std::make_unique<RecordingStage>(options_.output.dir, options_.recording,
-                                                 options_.executors.telemetry, deterministic);
-    recording->Start();
-    pipeline.SetRecorder(recording.get());
+  std::unique_ptr<TelemetryStage> telemetry;
+  if (options_.recording.enabled || options_.live.enabled) {
+    telemetry = std::make_unique<TelemetryStage>(options_.executors.telemetry,
+                                                 static_cast<size_t>(options_.queues.telemetry), deterministic);
+    if (options_.recording.enabled) telemetry->EnableRecording(options_.output.dir, options_.recording);
+    if (options_.live.enabled) {
+      if (Status s = telemetry->EnableLiveStream(options_.robot.name, options_.live); !s.ok()) {
+        // Degrade: no live view, everything else runs.
+        spdlog::error("{}", s.ToString());
+      } else {
+        spdlog::info("live stream (Foxglove WebSocket) on ws://{}:{}", options_.live.address,
+                     telemetry->live_report().port);
+      }
+    }
+    telemetry->Start();
+    pipeline.SetTelemetry(telemetry.get());
   }
   pipeline.Start();
   // Everything the system refused of the requested scheduling, in one warning.
@@ -168,10 +178,11 @@ int Cairnd::Run() {
   notifier.Stopping();
   for (auto& s : sources_) s->Stop();
   pipeline.StopAndDrain();
-  if (recording) {
-    recording->StopAndDrain();
-    run.recording = recording->report();
-    run.recording_dropped = recording->dropped();
+  if (telemetry) {
+    telemetry->StopAndDrain();
+    if (telemetry->recording()) run.recording = telemetry->recording_report();
+    if (options_.live.enabled) run.live = telemetry->live_report();
+    run.telemetry_dropped = telemetry->dropped();
   }
   run.complete = finite && run.stop_reason == "end_of_data";
   run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

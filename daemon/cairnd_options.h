@@ -6,6 +6,7 @@
 #include <string>
 
 #include "daemon/executor_options.h"
+#include "daemon/live_stream_options.h"
 #include "daemon/recording_options.h"
 #include "drivers/can_wheel_options.h"
 #include "drivers/replay_options.h"
@@ -64,6 +65,7 @@ struct CairndOptions {
   DaemonOptions daemon;
   OutputOptions output;
   RecordingOptions recording;
+  LiveStreamOptions live;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -75,6 +77,7 @@ struct CairndOptions {
     v.Section("daemon", daemon);
     v.Section("output", output);
     v.Section("recording", recording);
+    v.Section("live", live);
   }
 };
 

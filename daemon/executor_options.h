@@ -51,11 +51,14 @@ struct QueueOptions {
   int64_t imu = 2048;
   int64_t wheel_odometry = 512;
   int64_t stereo = 4;
+  // Samples waiting for the telemetry executor (recording, live stream); IMU gets 8x this.
+  int64_t telemetry = 64;
 
   void Visit(OptionsVisitor& v) {
     v.Integer("imu", imu, 2, 1 << 20, "samples");
     v.Integer("wheel_odometry", wheel_odometry, 2, 1 << 20, "samples");
     v.Integer("stereo", stereo, 2, 1024, "frames");
+    v.Integer("telemetry", telemetry, 2, 1 << 20, "samples");
   }
 };
 

@@ -1,19 +1,15 @@
 #pragma once
-// Writes HAL samples as protobuf messages into MCAP files, rotating to a new file when the current
-// one exceeds the configured size. Channels: /imu (cairn.ImuSample), /wheel_odometry
-// (cairn.WheelOdometrySample), /stereo/info (cairn.StereoFrameInfo), /cam0/image and /cam1/image
-// (foxglove.RawImage, viewable in Foxglove as they are).
+// Writes encoded telemetry (see sample_encoder.h) into MCAP files, one channel per topic, rotating
+// to a new self-contained file when the current one exceeds the configured size.
 
 #include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
 
-#include "drivers/mcap/mcap_writer.h"
 #include "daemon/recording_options.h"
-#include "hal/imu_sample.h"
-#include "hal/stereo_frame.h"
-#include "hal/wheel_odometry_sample.h"
+#include "daemon/sample_encoder.h"
+#include "drivers/mcap/mcap_writer.h"
 
 namespace cairn {
 
@@ -29,28 +25,23 @@ class McapRecorder {
   McapRecorder(std::string directory, RecordingOptions options);
   ~McapRecorder();
 
-  Status RecordImu(const ImuSample& s);
-  Status RecordWheelOdometry(const WheelOdometrySample& s);
-  Status RecordStereo(const StereoFrame& f);
+  Status Write(TelemetryTopic topic, Timestamp time, const std::string& encoded);
   // Closes the current file (writing its summary).
   Status Close();
 
   const RecordingReport& report() const { return report_; }
 
  private:
-  enum Topic { kImu, kWheel, kStereoInfo, kCam0, kCam1, kTopicCount };
   Status EnsureOpen();
-  Status Write(Topic topic, Timestamp time, const std::string& bytes);
 
   std::string directory_;
   RecordingOptions options_;
   McapWriter writer_;
   int file_index_ = 0;
-  uint16_t channel_[kTopicCount] = {};
-  uint32_t sequence_[kTopicCount] = {};
+  uint16_t channel_[kTelemetryTopicCount] = {};
+  uint32_t sequence_[kTelemetryTopicCount] = {};
   uint64_t bytes_closed_ = 0;  // in files already rotated out
   RecordingReport report_;
-  std::string scratch_;
 };
 
 }  // namespace cairn

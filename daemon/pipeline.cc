@@ -92,11 +92,11 @@ void Pipeline::EstimationLoop(std::stop_token stop) {
       const Timestamp tt = trig ? trig->time : Timestamp::Max();
       if (imu != nullptr && ti <= tw && ti <= tt) {
         imu_stats_.Add(ti);
-        if (recorder_ != nullptr) recorder_->OfferImu(*imu);
+        if (telemetry_ != nullptr) telemetry_->OfferImu(*imu);
         imu_queue_.PopFront();
       } else if (wheel != nullptr && tw <= tt) {
         wheel_stats_.Add(tw);
-        if (recorder_ != nullptr) recorder_->OfferWheelOdometry(*wheel);
+        if (telemetry_ != nullptr) telemetry_->OfferWheelOdometry(*wheel);
         wheel_queue_.PopFront();
       } else {
         trigger_stats_.Add(tt);
@@ -128,7 +128,7 @@ void Pipeline::StereoLoop(std::stop_token stop) {
         stereo_report_.width = f->left.width;
         stereo_report_.height = f->left.height;
       }
-      if (recorder_ != nullptr) recorder_->OfferStereo(*f);
+      if (telemetry_ != nullptr) telemetry_->OfferStereo(*f);
       stereo_queue_.PopFront();
       worked = true;
       if (deterministic_) consumed_signal_.Notify();

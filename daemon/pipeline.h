@@ -14,7 +14,7 @@
 
 #include "daemon/executor.h"
 #include "daemon/executor_options.h"
-#include "daemon/recording_stage.h"
+#include "daemon/telemetry_stage.h"
 #include "daemon/sensor_stream_stats.h"
 #include "daemon/spsc_queue.h"
 #include "hal/sensor_sink.h"
@@ -54,9 +54,9 @@ class Pipeline final : public SensorSink {
            bool deterministic);
   ~Pipeline() override;
 
-  // Hands every consumed sample on to `recorder` (which must outlive the pipeline's threads).
+  // Hands every consumed sample on to `telemetry` (which must outlive the pipeline's threads).
   // Call before Start().
-  void SetRecorder(RecordingStage* recorder) { recorder_ = recorder; }
+  void SetTelemetry(TelemetryStage* telemetry) { telemetry_ = telemetry; }
   // Starts the stage threads.
   void Start();
   // Lets the stages consume what is queued, then joins them. Publishing must have stopped.
@@ -110,7 +110,7 @@ class Pipeline final : public SensorSink {
   StereoStageReport stereo_report_;
   uint64_t last_frame_counter_ = 0;
 
-  RecordingStage* recorder_ = nullptr;
+  TelemetryStage* telemetry_ = nullptr;
   mutable std::mutex fault_mutex_;
   FaultReport faults_;
   bool started_ = false;

@@ -12,8 +12,6 @@ struct RecordingOptions {
   McapCompression compression = McapCompression::kZstd;
   int64_t chunk_size = 4 << 20;
   int64_t rotate_size = int64_t{1} << 30;
-  // Samples waiting to be written; a full queue drops (live) or waits (deterministic replay).
-  int64_t queue_depth = 64;
 
   void Visit(OptionsVisitor& v) {
     v.Flag("enabled", enabled);
@@ -22,7 +20,6 @@ struct RecordingOptions {
                                           {"lz4", McapCompression::kLz4}});
     v.Integer("chunk_size", chunk_size, 4096, int64_t{1} << 30, "bytes");
     v.Integer("rotate_size", rotate_size, int64_t{1} << 20, int64_t{1} << 40, "bytes");
-    v.Integer("queue_depth", queue_depth, 2, 1 << 20, "samples");
   }
   Status Validate() const {
     return rotate_size > chunk_size ? Status::Ok()

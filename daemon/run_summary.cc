@@ -69,7 +69,7 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     for (const auto& [topic, n] : run.recording->messages) j.Field(topic, n);
     j.EndObject();
     j.Field("bytes", run.recording->bytes);
-    j.Field("dropped", run.recording_dropped);
+    j.Field("dropped", run.telemetry_dropped);
     j.Field("write_errors", run.recording->write_errors);
     j.EndObject();
   }
@@ -109,6 +109,12 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
     j.EndObject();
   }
   j.EndArray();
+  if (run.live) {
+    j.Key("live_stream").BeginObject();
+    j.Field("port", run.live->port).Field("published", run.live->published);
+    j.Field("dropped_for_slow_clients", run.live->dropped).Field("protocol_errors", run.live->protocol_errors);
+    j.EndObject();
+  }
   j.Key("queues").BeginArray();
   for (const QueueReport& q : p.queue_reports()) {
     j.BeginObject();

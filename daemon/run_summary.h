@@ -7,7 +7,7 @@
 #include <string>
 
 #include "daemon/pipeline.h"
-#include "daemon/mcap_recorder.h"
+#include "daemon/telemetry_stage.h"
 
 namespace cairn {
 
@@ -28,7 +28,8 @@ struct RunInfo {
   bool complete = false;    // all input consumed (replay) 
   std::optional<ReplayInfo> replay;
   std::optional<RecordingReport> recording;
-  uint64_t recording_dropped = 0;
+  std::optional<LiveStreamReport> live;
+  uint64_t telemetry_dropped = 0;
   double wall_time = 0.0;   // s
   bool memory_locked = false;
   std::string memory_lock_note;

@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   # libraries
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler
+  libgtest-dev libgmock-dev libbenchmark-dev libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev
   # tools used by tests and scripts
   systemd iproute2 can-utils util-linux file
 )

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "drivers/mcap/mcap_writer.h"
+#include "tests/support/js_clients.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
@@ -16,29 +17,6 @@ namespace cairn {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Installs tests/js into the build tree once (npm's own cache makes repeats cheap).
-std::string InstallJsClients(std::string* why_not) {
-  if (!fs::exists("/usr/bin/node") || !fs::exists("/usr/bin/npm")) {
-    *why_not = "missing /usr/bin/node or /usr/bin/npm";
-    return "";
-  }
-  const std::string dir = testing::BinaryDir() + "/js-clients";
-  if (!fs::exists(dir + "/node_modules/@mcap/core")) {
-    fs::create_directories(dir);
-    fs::copy_file(testing::SourceDir() + "/tests/js/package.json", dir + "/package.json",
-                  fs::copy_options::overwrite_existing);
-    const auto r = testing::RunProcess({"/usr/bin/npm", "install", "--prefix", dir, "--no-audit",
-                                        "--no-fund", "--silent"});
-    if (r.exit_code != 0) {
-      *why_not = "npm install of tests/js failed (no registry access?): " + r.output.substr(0, 300);
-      return "";
-    }
-  }
-  fs::copy_file(testing::SourceDir() + "/tests/js/mcap_check.mjs", dir + "/mcap_check.mjs",
-                fs::copy_options::overwrite_existing);
-  return dir;
-}
 
 void WriteSample(const std::string& path, McapCompression c, bool close, McapWriter* w) {
   McapWriterOptions o;
@@ -63,7 +41,7 @@ void WriteSample(const std::string& path, McapCompression c, bool close, McapWri
 
 TEST(McapJsReaderTest, FoxgloveReaderReadsEveryCompressionAndACrashedFile) {
   std::string why_not;
-  const std::string js = InstallJsClients(&why_not);
+  const std::string js = testing::InstallJsClients(&why_not);
   if (js.empty()) GTEST_SKIP() << why_not;
   const std::string dir = testing::FreshTempDir("mcap_js");
   std::vector<std::string> files;

@@ -1,11 +1,11 @@
-#include "tests/support/json_value.h"
+#include "daemon/json_value.h"
 
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-namespace cairn::testing {
+namespace cairn {
 
 class JsonParser {
  public:
@@ -161,4 +161,4 @@ const JsonValue& JsonValue::operator[](const std::string& key) const {
   return it->second;
 }
 
-}  // namespace cairn::testing
+}  // namespace cairn

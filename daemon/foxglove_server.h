@@ -1,0 +1,67 @@
+#pragma once
+// Foxglove WebSocket protocol v1 on top of WebSocketServer: server info and channel adverts on
+// connect, subscribe/unsubscribe, and binary Message Data frames to each subscriber. Publish() is
+// safe from any thread and never blocks on the network.
+
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <set>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "daemon/websocket_server.h"
+#include "hal/status.h"
+#include "hal/timestamp.h"
+
+namespace cairn {
+
+struct FoxgloveChannel {
+  uint32_t id = 0;
+  std::string topic;
+  std::string encoding;         // "protobuf", "json"
+  std::string schema_name;
+  std::string schema;           // as sent: base64 FileDescriptorSet for protobuf, text for json
+  std::string schema_encoding;  // "protobuf", "jsonschema"
+};
+
+class FoxgloveServer {
+ public:
+  explicit FoxgloveServer(std::string name) : name_(std::move(name)) {}
+  ~FoxgloveServer() { Stop(); }
+
+  // Channels must be added before Start().
+  uint32_t AddChannel(FoxgloveChannel channel);
+  Status Start(const std::string& address, uint16_t port, size_t client_queue);
+  void Stop();
+  uint16_t port() const { return server_.port(); }
+
+  // True when some client subscribes to `channel` (so callers can skip serializing).
+  bool HasSubscribers(uint32_t channel) const;
+  void Publish(uint32_t channel, Timestamp time, std::span<const uint8_t> payload);
+
+  uint64_t dropped_messages() const { return server_.dropped_messages(); }
+  size_t client_count() const { return server_.client_count(); }
+  uint64_t protocol_errors() const;
+
+  static std::string Base64(std::span<const uint8_t> bytes);
+
+ private:
+  void OnOpen(uint64_t client);
+  void OnClose(uint64_t client);
+  void OnText(uint64_t client, const std::string& text);
+  void SendStatus(uint64_t client, int level, const std::string& message);
+
+  std::string name_;
+  std::vector<FoxgloveChannel> channels_;
+  WebSocketServer server_;
+  mutable std::mutex mutex_;
+  // client -> subscription id -> channel
+  std::map<uint64_t, std::map<uint32_t, uint32_t>> subscriptions_;
+  std::map<uint32_t, size_t> subscriber_count_;  // channel -> subscriptions
+  uint64_t protocol_errors_ = 0;
+  bool started_ = false;
+};
+
+}  // namespace cairn

@@ -1,0 +1,161 @@
+#include "daemon/telemetry_stage.h"
+
+#include <spdlog/spdlog.h>
+
+#include <limits>
+
+#include "daemon/protobuf_schema.h"
+
+namespace cairn {
+
+TelemetryStage::TelemetryStage(const ExecutorOptions& executor, size_t queue_depth, bool deterministic)
+    : deterministic_(deterministic),
+      imu_(queue_depth * 8),  // IMU samples are small and frequent
+      wheel_(queue_depth),
+      stereo_(queue_depth),
+      executor_("telemetry", executor) {}
+
+TelemetryStage::~TelemetryStage() { StopAndDrain(); }
+
+void TelemetryStage::EnableRecording(std::string directory, const RecordingOptions& options) {
+  recorder_ = std::make_unique<McapRecorder>(std::move(directory), options);
+}
+
+Status TelemetryStage::EnableLiveStream(const std::string& robot_name, const LiveStreamOptions& options) {
+  live_ = std::make_unique<FoxgloveServer>("cairnd " + robot_name);
+  for (int t = 0; t < kTelemetryTopicCount; ++t) {
+    const auto topic = static_cast<TelemetryTopic>(t);
+    const auto* d = TelemetryTopicDescriptor(topic);
+    const std::string set = ProtobufFileDescriptorSet(d);
+    live_channel_[t] = live_->AddChannel(FoxgloveChannel{
+        0, TelemetryTopicName(topic), "protobuf", d->full_name(),
+        FoxgloveServer::Base64({reinterpret_cast<const uint8_t*>(set.data()), set.size()}), "protobuf"});
+  }
+  image_every_ = options.image_every;
+  const Status s = live_->Start(options.address, static_cast<uint16_t>(options.port),
+                                static_cast<size_t>(options.client_queue));
+  if (!s.ok()) live_.reset();
+  return s;
+}
+
+void TelemetryStage::Start() {
+  if (started_) return;
+  started_ = true;
+  executor_.Start([this](std::stop_token stop) { Loop(stop); });
+}
+
+void TelemetryStage::StopAndDrain() {
+  if (!started_) return;
+  executor_.RequestStop();
+  work_.Notify();
+  executor_.Join();
+  started_ = false;
+  if (recorder_) {
+    if (Status s = recorder_->Close(); !s.ok()) spdlog::error("recording: {}", s.ToString());
+  }
+  if (live_) live_->Stop();
+}
+
+LiveStreamReport TelemetryStage::live_report() const {
+  LiveStreamReport r;
+  if (!live_) return r;
+  r.port = live_->port();
+  r.published = live_published_.load();
+  r.dropped = live_->dropped_messages();
+  r.protocol_errors = live_->protocol_errors();
+  return r;
+}
+
+template <class T>
+void TelemetryStage::Offer(SpscQueue<Item<T>>& queue, const T& value) {
+  const Item<T> item{next_sequence_.fetch_add(1, std::memory_order_relaxed), value};
+  if (deterministic_) {
+    while (true) {
+      const uint32_t seen = space_.sequence();
+      if (queue.size() < queue.capacity() && queue.TryPush(item)) break;
+      space_.WaitChange(seen);
+    }
+  } else {
+    queue.TryPush(item);
+  }
+  work_.Notify();
+}
+
+void TelemetryStage::OfferImu(const ImuSample& s) { Offer(imu_, s); }
+void TelemetryStage::OfferWheelOdometry(const WheelOdometrySample& s) { Offer(wheel_, s); }
+void TelemetryStage::OfferStereo(const StereoFrame& f) { Offer(stereo_, f); }
+
+void TelemetryStage::Emit(TelemetryTopic topic, Timestamp time, const std::string& encoded) {
+  if (recorder_) {
+    const Status s = recorder_->Write(topic, time, encoded);
+    if (!s.ok() && !error_logged_) {
+      // A full disk must not stop the robot: log once, count the rest in the report.
+      spdlog::error("recording: {} (further errors are only counted)", s.ToString());
+      error_logged_ = true;
+    }
+  }
+  if (live_) {
+    const uint32_t channel = live_channel_[static_cast<int>(topic)];
+    if (live_->HasSubscribers(channel)) {
+      live_->Publish(channel, time, {reinterpret_cast<const uint8_t*>(encoded.data()), encoded.size()});
+      live_published_.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+}
+
+void TelemetryStage::HandleStereo(const StereoFrame& f) {
+  Emit(TelemetryTopic::kStereoInfo, f.time, encoder_.StereoInfo(f));
+  const bool live_images = live_ && stereo_seen_ % static_cast<uint64_t>(image_every_) == 0 &&
+                           (live_->HasSubscribers(live_channel_[static_cast<int>(TelemetryTopic::kCam0Image)]) ||
+                            live_->HasSubscribers(live_channel_[static_cast<int>(TelemetryTopic::kCam1Image)]));
+  ++stereo_seen_;
+  if (!recorder_ && !live_images) return;  // images are the expensive part: encode only when needed
+  const struct { TelemetryTopic topic; const Image* image; const char* frame; } sides[] = {
+      {TelemetryTopic::kCam0Image, &f.left, "cam0"}, {TelemetryTopic::kCam1Image, &f.right, "cam1"}};
+  for (const auto& side : sides) {
+    const std::string& encoded = encoder_.Image(*side.image, f.time, side.frame);
+    if (recorder_) {
+      if (Status s = recorder_->Write(side.topic, f.time, encoded); !s.ok() && !error_logged_) {
+        spdlog::error("recording: {} (further errors are only counted)", s.ToString());
+        error_logged_ = true;
+      }
+    }
+    if (live_images) {
+      live_->Publish(live_channel_[static_cast<int>(side.topic)], f.time,
+                     {reinterpret_cast<const uint8_t*>(encoded.data()), encoded.size()});
+      live_published_.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
+}
+
+void TelemetryStage::Loop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { work_.Notify(); });
+  constexpr uint64_t kNone = std::numeric_limits<uint64_t>::max();
+  while (true) {
+    const uint32_t seen = work_.sequence();
+    bool worked = false;
+    while (true) {
+      const auto* i = imu_.Front();
+      const auto* w = wheel_.Front();
+      const auto* s = stereo_.Front();
+      const uint64_t si = i ? i->sequence : kNone, sw = w ? w->sequence : kNone, ss = s ? s->sequence : kNone;
+      if (si == kNone && sw == kNone && ss == kNone) break;
+      if (si <= sw && si <= ss) {
+        Emit(TelemetryTopic::kImu, i->value.time, encoder_.Imu(i->value));
+        imu_.PopFront();
+      } else if (sw <= ss) {
+        Emit(TelemetryTopic::kWheelOdometry, w->value.time, encoder_.WheelOdometry(w->value));
+        wheel_.PopFront();
+      } else {
+        HandleStereo(s->value);
+        stereo_.PopFront();
+      }
+      worked = true;
+      space_.Notify();
+    }
+    if (stop.stop_requested() && imu_.empty() && wheel_.empty() && stereo_.empty()) return;
+    if (!worked) work_.WaitChange(seen);
+  }
+}
+
+}  // namespace cairn

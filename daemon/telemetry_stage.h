@@ -1,0 +1,81 @@
+#pragma once
+// The telemetry executor: what the stages consumed is encoded once and goes to the MCAP recorder
+// and to the live Foxglove stream (each optional). Stages hand samples over through bounded
+// queues (allocation and lock free, so the estimation thread may call it); each item carries a
+// global sequence number so recordings keep the order in which the pipeline consumed samples.
+// Live: a full queue drops and counts. Deterministic replay: the stage waits instead.
+
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "daemon/executor.h"
+#include "daemon/foxglove_server.h"
+#include "daemon/live_stream_options.h"
+#include "daemon/mcap_recorder.h"
+#include "daemon/sample_encoder.h"
+#include "daemon/spsc_queue.h"
+
+namespace cairn {
+
+struct LiveStreamReport {
+  uint16_t port = 0;
+  uint64_t published = 0;
+  uint64_t dropped = 0;       // oldest messages dropped for slow clients
+  uint64_t protocol_errors = 0;
+};
+
+class TelemetryStage {
+ public:
+  TelemetryStage(const ExecutorOptions& executor, size_t queue_depth, bool deterministic);
+  ~TelemetryStage();
+
+  void EnableRecording(std::string directory, const RecordingOptions& options);
+  Status EnableLiveStream(const std::string& robot_name, const LiveStreamOptions& options);
+
+  void Start();
+  // Handles everything queued, closes the recording and the stream, joins the thread.
+  void StopAndDrain();
+
+  void OfferImu(const ImuSample& s);
+  void OfferWheelOdometry(const WheelOdometrySample& s);
+  void OfferStereo(const StereoFrame& f);
+
+  bool recording() const { return recorder_ != nullptr; }
+  const RecordingReport& recording_report() const { return recorder_->report(); }
+  LiveStreamReport live_report() const;
+  uint64_t dropped() const { return imu_.dropped() + wheel_.dropped() + stereo_.dropped(); }
+  ExecutorReport executor_report() const { return executor_.report(); }
+
+ private:
+  template <class T>
+  struct Item {
+    uint64_t sequence = 0;
+    T value{};
+  };
+  template <class T>
+  void Offer(SpscQueue<Item<T>>& queue, const T& value);
+  void Loop(std::stop_token stop);
+  void Emit(TelemetryTopic topic, Timestamp time, const std::string& encoded);
+  void HandleStereo(const StereoFrame& f);
+
+  const bool deterministic_;
+  std::atomic<uint64_t> next_sequence_{0};
+  WorkSignal work_;
+  WorkSignal space_;
+  SpscQueue<Item<ImuSample>> imu_;
+  SpscQueue<Item<WheelOdometrySample>> wheel_;
+  SpscQueue<Item<StereoFrame>> stereo_;
+  SampleEncoder encoder_;
+  std::unique_ptr<McapRecorder> recorder_;
+  std::unique_ptr<FoxgloveServer> live_;
+  uint32_t live_channel_[kTelemetryTopicCount] = {};
+  int64_t image_every_ = 1;
+  uint64_t stereo_seen_ = 0;
+  std::atomic<uint64_t> live_published_{0};
+  Executor executor_;
+  bool started_ = false;
+  bool error_logged_ = false;
+};
+
+}  // namespace cairn

@@ -1,0 +1,102 @@
+// The live stream seen through Foxglove's own client: @foxglove/ws-protocol connects to a running
+// cairnd, subscribes to every advertised channel and decodes every message with the advertised
+// protobuf schema (protobufjs), while 20 more clients subscribe and vanish abruptly.
+
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "tests/support/js_clients.h"
+#include "tests/support/json_value.h"
+#include "tests/support/process_runner.h"
+#include "tests/support/test_data.h"
+
+namespace cairn {
+namespace {
+
+namespace fs = std::filesystem;
+
+int FreeLoopbackPort() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a));
+  socklen_t len = sizeof(a);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  close(fd);
+  return ntohs(a.sin_port);
+}
+
+bool CanConnect(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  const bool ok = connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0;
+  close(fd);
+  return ok;
+}
+
+TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
+  if (!fs::exists(testing::EurocMicro())) GTEST_SKIP() << "missing " << testing::EurocMicro();
+  std::string why_not;
+  const std::string js = testing::InstallJsClients(&why_not);
+  if (js.empty()) GTEST_SKIP() << why_not;
+  const int port = FreeLoopbackPort();
+  const std::string out = testing::FreshTempDir("live");
+  testing::ProcessResult daemon;
+  std::thread runner([&] {
+    testing::ProcessOptions po;
+    po.signal = SIGTERM;
+    po.signal_when_output_contains = "live stream";
+    po.signal_after = std::chrono::milliseconds(9000);
+    daemon = testing::RunProcess(
+        {testing::BinaryDir() + "/daemon/cairnd", "--config", testing::SourceDir() + "/configs/euroc.yaml",
+         "--replay", testing::EurocMicro(), "--out", out, "--set", "live.enabled=true", "--set",
+         "live.port=" + std::to_string(port), "--set", "replay.pacing=realtime", "--set", "live.image_every=2"},
+        po);
+  });
+  bool up = false;
+  for (int i = 0; i < 300 && !up; ++i) {
+    up = CanConnect(port);
+    if (!up) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  testing::ProcessResult client;
+  if (up) {
+    client = testing::RunProcess({"/usr/bin/node", js + "/ws_check.mjs",
+                                  "ws://127.0.0.1:" + std::to_string(port), "4", "20"});
+  }
+  runner.join();
+  ASSERT_TRUE(up) << daemon.output;
+  ASSERT_EQ(daemon.exit_code, 0) << daemon.output;
+  ASSERT_EQ(client.exit_code, 0) << client.output;
+  const testing::JsonValue r = testing::JsonValue::Parse(client.output);
+  EXPECT_EQ(r["serverInfo"].string(), "cairnd euroc-mav");
+  EXPECT_TRUE(r["errors"].array().empty()) << client.output;
+  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image", "/cam1/image"}) {
+    const testing::JsonValue& c = r["channels"][topic];
+    EXPECT_GT(c["count"].number(), 0) << topic;
+    EXPECT_EQ(c["decodeErrors"].number(), 0) << topic;
+    EXPECT_TRUE(c["increasing"].boolean()) << topic;
+    EXPECT_FALSE(c["last"].is_null()) << topic;
+  }
+  // Real-time IMU at 200 Hz for about 4 s.
+  EXPECT_GT(r["channels"]["/imu"]["count"].number(), 400);
+  EXPECT_EQ(r["channels"]["/cam0/image"]["lastImage"]["width"].number(), 752);
+  EXPECT_EQ(r["channels"]["/cam0/image"]["lastImage"]["bytes"].number(), 752 * 480);
+  EXPECT_EQ(r["channels"]["/wheel_odometry"]["schema"].string(), "cairn.msg.WheelOdometrySample");
+  const testing::JsonValue d = testing::JsonValue::ParseFile(out + "/diagnostics.json");
+  EXPECT_EQ(d["live_stream"]["port"].number(), port);
+  EXPECT_GT(d["live_stream"]["published"].number(), 400);
+}
+
+}  // namespace
+}  // namespace cairn

@@ -1,0 +1,78 @@
+// Connects Foxglove's own WebSocket client (@foxglove/ws-protocol) to a running cairnd, subscribes
+// to every advertised channel, decodes each message with the advertised protobuf schema
+// (protobufjs), and prints one JSON line of what it saw.
+//   node ws_check.mjs URL SECONDS [EXTRA_CLIENTS]
+// EXTRA_CLIENTS further raw connections subscribe to everything and then vanish abruptly, half
+// of them in the middle of the stream, to check that the server survives them.
+import wsProtocol from "@foxglove/ws-protocol";
+import WebSocket from "ws";
+import protobuf from "protobufjs";
+import descriptor from "protobufjs/ext/descriptor/index.js";
+
+const { FoxgloveClient } = wsProtocol;
+const [url, seconds, extra = "0"] = process.argv.slice(2);
+const result = { channels: {}, serverInfo: null, errors: [] };
+
+function rootFor(channel) {
+  const bytes = Buffer.from(channel.schema, "base64");
+  const set = descriptor.FileDescriptorSet.decode(bytes);
+  return protobuf.Root.fromDescriptor(set);
+}
+
+function timeOf(topic, m) {
+  const ns = m.timeNs ?? m.time_ns;
+  if (ns !== undefined && ns !== null) return BigInt(ns.toString());
+  if (m.timestamp) return BigInt(m.timestamp.seconds.toString()) * 1000000000n + BigInt(m.timestamp.nanos ?? 0);
+  return null;
+}
+
+// Abrupt clients: connect, subscribe, then drop the TCP connection without a close handshake.
+for (let i = 0; i < Number(extra); i++) {
+  const ws = new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
+  ws.on("error", () => {});
+  ws.on("message", (data, isBinary) => {
+    if (isBinary) return;
+    const msg = JSON.parse(data.toString());
+    if (msg.op === "advertise") {
+      ws.send(JSON.stringify({ op: "subscribe", subscriptions: msg.channels.map((c, k) => ({ id: k, channelId: c.id })) }));
+      setTimeout(() => ws.terminate(), i % 2 === 0 ? 50 : 400);
+    }
+  });
+}
+
+const client = new FoxgloveClient({ ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
+const subs = new Map();
+client.on("serverInfo", (info) => { result.serverInfo = info.name; });
+client.on("error", (e) => result.errors.push(String(e?.message ?? e)));
+client.on("advertise", (channels) => {
+  for (const ch of channels) {
+    try {
+      const type = rootFor(ch).lookupType(ch.schemaName);
+      const id = client.subscribe(ch.id);
+      subs.set(id, { ch, type });
+      result.channels[ch.topic] = { schema: ch.schemaName, count: 0, increasing: true, last: null, decodeErrors: 0 };
+    } catch (e) {
+      result.errors.push(`schema of ${ch.topic}: ${e.message}`);
+    }
+  }
+});
+client.on("message", ({ subscriptionId, data }) => {
+  const s = subs.get(subscriptionId);
+  if (!s) return;
+  const r = result.channels[s.ch.topic];
+  try {
+    const m = s.type.decode(new Uint8Array(data.buffer, data.byteOffset, data.byteLength));
+    const t = timeOf(s.ch.topic, m);
+    if (t !== null && r.last !== null && t <= BigInt(r.last)) r.increasing = false;
+    if (t !== null) r.last = t.toString();
+    if (s.ch.topic.endsWith("/image")) r.lastImage = { width: m.width, height: m.height, bytes: m.data.length, encoding: m.encoding };
+    r.count++;
+  } catch (e) {
+    r.decodeErrors++;
+  }
+});
+setTimeout(() => {
+  client.close();
+  console.log(JSON.stringify(result));
+  process.exit(0);
+}, Number(seconds) * 1000);
