@@ -14,6 +14,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
     {"mcap info", "summarize MCAP recordings (also ones cut short by a crash)", RunMcapInfo},
+    {"trajectory convert", "convert trajectories between TUM, EuRoC CSV and KITTI", RunTrajectoryConvert},
 });
 
 void PrintHelp() {

@@ -7,5 +7,6 @@ namespace cairn::tools {
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
 int RunMcapInfo(const CommandArgs& args);
+int RunTrajectoryConvert(const CommandArgs& args);
 
 }  // namespace cairn::tools
