@@ -169,7 +169,10 @@ int Cairnd::Run() {
       next_status += std::chrono::duration_cast<std::chrono::steady_clock::duration>(status_period);
       const std::string status = "imu " + std::to_string(pipeline.consumed_imu()) + ", stereo " +
                                  std::to_string(pipeline.consumed_stereo()) + ", dropped " +
-                                 std::to_string(pipeline.total_dropped());
+                                 std::to_string(pipeline.total_dropped()) + ", deadline misses " +
+                                 std::to_string(pipeline.deadline_misses()) + ", faults " +
+                                 std::to_string(pipeline.fault_report().total);
+      if (telemetry) telemetry->PublishDiagnostics(status);
       notifier.Status(status);
       spdlog::debug("{}", status);
     }
@@ -183,6 +186,7 @@ int Cairnd::Run() {
     if (telemetry->recording()) run.recording = telemetry->recording_report();
     if (options_.live.enabled) run.live = telemetry->live_report();
     run.telemetry_dropped = telemetry->dropped();
+    run.extra_executors.push_back(telemetry->executor_report());
   }
   run.complete = finite && run.stop_reason == "end_of_data";
   run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

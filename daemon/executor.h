@@ -18,6 +18,7 @@ struct ExecutorReport {
   std::string policy;        // "SCHED_FIFO" or "SCHED_OTHER"
   int priority = 0;
   std::string affinity_note; // empty when as requested
+  double cpu_seconds = 0.0;  // CPU time the thread used, set when it ends
 };
 
 class Executor {

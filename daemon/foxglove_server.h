@@ -42,6 +42,7 @@ class FoxgloveServer {
   void Publish(uint32_t channel, Timestamp time, std::span<const uint8_t> payload);
 
   uint64_t dropped_messages() const { return server_.dropped_messages(); }
+  double cpu_seconds() const { return server_.cpu_seconds(); }
   size_t client_count() const { return server_.client_count(); }
   uint64_t protocol_errors() const;
 

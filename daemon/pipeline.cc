@@ -2,9 +2,19 @@
 
 #include <spdlog/spdlog.h>
 
+#include <ctime>
 #include <thread>
 
 namespace cairn {
+namespace {
+
+int64_t MonotonicNs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+}  // namespace
 
 Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues,
                    PipelineRates rates, bool deterministic)
@@ -13,6 +23,7 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       wheel_queue_(static_cast<size_t>(queues.wheel_odometry)),
       trigger_queue_(static_cast<size_t>(queues.wheel_odometry)),
       stereo_queue_(static_cast<size_t>(queues.stereo)),
+      imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
       estimation_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
       imu_stats_(rates.imu_hz),
@@ -41,7 +52,8 @@ void Pipeline::StopAndDrain() {
 }
 
 template <class T>
-void Pipeline::Publish(SpscQueue<T>& queue, const T& item, WorkSignal& signal) {
+void Pipeline::Publish(SpscQueue<Queued<T>>& queue, const T& value, WorkSignal& signal) {
+  const Queued<T> item{MonotonicNs(), value};
   if (!deterministic_) {
     if (queue.TryPush(item)) signal.Notify();
     return;
@@ -83,20 +95,25 @@ void Pipeline::EstimationLoop(std::stop_token stop) {
     bool worked = false;
     // Consume the three inputs in timestamp order.
     while (true) {
-      const ImuSample* imu = imu_queue_.Front();
-      const WheelOdometrySample* wheel = wheel_queue_.Front();
-      const TriggerEvent* trig = trigger_queue_.Front();
+      const auto* imu = imu_queue_.Front();
+      const auto* wheel = wheel_queue_.Front();
+      const auto* trig = trigger_queue_.Front();
       if (imu == nullptr && wheel == nullptr && trig == nullptr) break;
-      const Timestamp ti = imu ? imu->time : Timestamp::Max();
-      const Timestamp tw = wheel ? wheel->time : Timestamp::Max();
-      const Timestamp tt = trig ? trig->time : Timestamp::Max();
+      const Timestamp ti = imu ? imu->value.time : Timestamp::Max();
+      const Timestamp tw = wheel ? wheel->value.time : Timestamp::Max();
+      const Timestamp tt = trig ? trig->value.time : Timestamp::Max();
+      const int64_t now = MonotonicNs();
       if (imu != nullptr && ti <= tw && ti <= tt) {
+        const Duration latency = Duration::Nanoseconds(now - imu->enqueued_ns);
+        imu_latency_.Record(latency);
+        if (latency > imu_deadline_) deadline_misses_.fetch_add(1, std::memory_order_relaxed);
         imu_stats_.Add(ti);
-        if (telemetry_ != nullptr) telemetry_->OfferImu(*imu);
+        if (telemetry_ != nullptr) telemetry_->OfferImu(imu->value);
         imu_queue_.PopFront();
       } else if (wheel != nullptr && tw <= tt) {
+        wheel_latency_.Record(Duration::Nanoseconds(now - wheel->enqueued_ns));
         wheel_stats_.Add(tw);
-        if (telemetry_ != nullptr) telemetry_->OfferWheelOdometry(*wheel);
+        if (telemetry_ != nullptr) telemetry_->OfferWheelOdometry(wheel->value);
         wheel_queue_.PopFront();
       } else {
         trigger_stats_.Add(tt);
@@ -117,7 +134,9 @@ void Pipeline::StereoLoop(std::stop_token stop) {
   while (true) {
     const uint32_t seen = stereo_signal_.sequence();
     bool worked = false;
-    while (const StereoFrame* f = stereo_queue_.Front()) {
+    while (const auto* queued = stereo_queue_.Front()) {
+      stereo_latency_.Record(Duration::Nanoseconds(MonotonicNs() - queued->enqueued_ns));
+      const StereoFrame* f = &queued->value;
       stereo_stats_.Add(f->time);
       if (stereo_stats_.count() > 1 && f->frame_counter > last_frame_counter_ + 1) {
         stereo_report_.frame_counter_gaps += f->frame_counter - last_frame_counter_ - 1;
@@ -149,6 +168,13 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
 uint64_t Pipeline::total_dropped() const {
   return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() +
          stereo_queue_.dropped();
+}
+
+std::vector<LatencyReport> Pipeline::latency_reports() const {
+  const auto r = [](const char* name, const LatencyHistogram& h) {
+    return LatencyReport{name, h.count(), h.Quantile(0.5).seconds(), h.Quantile(0.99).seconds(), h.max().seconds()};
+  };
+  return {r("imu", imu_latency_), r("wheel_odometry", wheel_latency_), r("stereo", stereo_latency_)};
 }
 
 std::vector<ExecutorReport> Pipeline::executor_reports() const {

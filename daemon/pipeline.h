@@ -14,6 +14,7 @@
 
 #include "daemon/executor.h"
 #include "daemon/executor_options.h"
+#include "daemon/latency_histogram.h"
 #include "daemon/telemetry_stage.h"
 #include "daemon/sensor_stream_stats.h"
 #include "daemon/spsc_queue.h"
@@ -39,6 +40,13 @@ struct FaultReport {
   std::map<std::string, std::map<std::string, uint64_t>> counts;  // device -> kind -> count
   uint64_t total = 0;
   std::vector<std::string> first_messages;                         // the first few, verbatim
+};
+
+// Time from publication to consumption by the stage, on the monotonic wall clock.
+struct LatencyReport {
+  std::string name;
+  uint64_t count = 0;
+  double p50 = 0.0, p99 = 0.0, max = 0.0;  // s
 };
 
 struct StereoStageReport {
@@ -76,16 +84,24 @@ class Pipeline final : public SensorSink {
   const StereoStageReport& stereo_report() const { return stereo_report_; }
   std::vector<QueueReport> queue_reports() const;
   std::vector<ExecutorReport> executor_reports() const;
+  std::vector<LatencyReport> latency_reports() const;
   FaultReport fault_report() const;
 
   // Live progress (any thread).
   uint64_t consumed_imu() const { return imu_queue_.popped(); }
   uint64_t consumed_stereo() const { return stereo_queue_.popped(); }
   uint64_t total_dropped() const;
+  // IMU samples the estimation thread consumed later than one IMU period after publication.
+  uint64_t deadline_misses() const { return deadline_misses_.load(std::memory_order_relaxed); }
 
  private:
   template <class T>
-  void Publish(SpscQueue<T>& queue, const T& item, WorkSignal& signal);
+  struct Queued {
+    int64_t enqueued_ns = 0;  // CLOCK_MONOTONIC
+    T value{};
+  };
+  template <class T>
+  void Publish(SpscQueue<Queued<T>>& queue, const T& item, WorkSignal& signal);
   void EstimationLoop(std::stop_token stop);
   void StereoLoop(std::stop_token stop);
 
@@ -93,10 +109,12 @@ class Pipeline final : public SensorSink {
   WorkSignal estimation_signal_;
   WorkSignal stereo_signal_;
   WorkSignal consumed_signal_;  // deterministic mode: the publisher waits on this
-  SpscQueue<ImuSample> imu_queue_;
-  SpscQueue<WheelOdometrySample> wheel_queue_;
-  SpscQueue<TriggerEvent> trigger_queue_;
-  SpscQueue<StereoFrame> stereo_queue_;
+  SpscQueue<Queued<ImuSample>> imu_queue_;
+  SpscQueue<Queued<WheelOdometrySample>> wheel_queue_;
+  SpscQueue<Queued<TriggerEvent>> trigger_queue_;
+  SpscQueue<Queued<StereoFrame>> stereo_queue_;
+  const Duration imu_deadline_;
+  std::atomic<uint64_t> deadline_misses_{0};
 
   Executor estimation_;
   Executor stereo_;
@@ -105,7 +123,9 @@ class Pipeline final : public SensorSink {
   SensorStreamStats imu_stats_;
   SensorStreamStats wheel_stats_;
   SensorStreamStats trigger_stats_;
+  LatencyHistogram imu_latency_, wheel_latency_;
   // Owned by the stereo thread until joined.
+  LatencyHistogram stereo_latency_;
   SensorStreamStats stereo_stats_;
   StereoStageReport stereo_report_;
   uint64_t last_frame_counter_ = 0;

@@ -98,13 +98,16 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
   j.Field("memory_locked", run.memory_locked);
   if (!run.memory_lock_note.empty()) j.Field("memory_lock_note", run.memory_lock_note);
   j.Key("executors").BeginArray();
-  for (const ExecutorReport& e : p.executor_reports()) {
+  std::vector<ExecutorReport> executors = p.executor_reports();
+  executors.insert(executors.end(), run.extra_executors.begin(), run.extra_executors.end());
+  for (const ExecutorReport& e : executors) {
     j.BeginObject();
     j.Field("name", e.name);
     j.Field("realtime_requested", e.realtime_requested);
     j.Field("realtime_granted", e.realtime_granted);
     j.Field("policy", e.policy);
     j.Field("priority", e.priority);
+    j.Field("cpu_seconds", e.cpu_seconds);
     if (!e.affinity_note.empty()) j.Field("note", e.affinity_note);
     j.EndObject();
   }
@@ -113,8 +116,18 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
     j.Key("live_stream").BeginObject();
     j.Field("port", run.live->port).Field("published", run.live->published);
     j.Field("dropped_for_slow_clients", run.live->dropped).Field("protocol_errors", run.live->protocol_errors);
+    j.Field("server_cpu_seconds", run.live->server_cpu_seconds);
     j.EndObject();
   }
+  j.Field("deadline_misses", p.deadline_misses());
+  j.Key("latency").BeginArray();
+  for (const LatencyReport& l : p.latency_reports()) {
+    j.BeginObject();
+    j.Field("stage_input", l.name).Field("count", l.count);
+    j.Field("p50_s", l.p50).Field("p99_s", l.p99).Field("max_s", l.max);
+    j.EndObject();
+  }
+  j.EndArray();
   j.Key("queues").BeginArray();
   for (const QueueReport& q : p.queue_reports()) {
     j.BeginObject();

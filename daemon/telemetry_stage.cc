@@ -4,7 +4,10 @@
 
 #include <limits>
 
+#include "daemon/json_writer.h"
 #include "daemon/protobuf_schema.h"
+
+#include <ctime>
 
 namespace cairn {
 
@@ -31,6 +34,10 @@ Status TelemetryStage::EnableLiveStream(const std::string& robot_name, const Liv
         0, TelemetryTopicName(topic), "protobuf", d->full_name(),
         FoxgloveServer::Base64({reinterpret_cast<const uint8_t*>(set.data()), set.size()}), "protobuf"});
   }
+  diagnostics_channel_ = live_->AddChannel(FoxgloveChannel{
+      0, "/diagnostics", "json", "cairn.Diagnostics",
+      R"({"type":"object","properties":{"status":{"type":"string"},"time_ns":{"type":"integer"}}})",
+      "jsonschema"});
   image_every_ = options.image_every;
   const Status s = live_->Start(options.address, static_cast<uint16_t>(options.port),
                                 static_cast<size_t>(options.client_queue));
@@ -63,6 +70,7 @@ LiveStreamReport TelemetryStage::live_report() const {
   r.published = live_published_.load();
   r.dropped = live_->dropped_messages();
   r.protocol_errors = live_->protocol_errors();
+  r.server_cpu_seconds = live_->cpu_seconds();
   return r;
 }
 
@@ -79,6 +87,16 @@ void TelemetryStage::Offer(SpscQueue<Item<T>>& queue, const T& value) {
     queue.TryPush(item);
   }
   work_.Notify();
+}
+
+void TelemetryStage::PublishDiagnostics(const std::string& status) {
+  if (!live_ || !live_->HasSubscribers(diagnostics_channel_)) return;
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  const Timestamp now = Timestamp::FromNanoseconds(static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec);
+  JsonWriter j(false);
+  j.BeginObject().Field("status", status).Field("time_ns", now.nanoseconds()).EndObject();
+  live_->Publish(diagnostics_channel_, now, {reinterpret_cast<const uint8_t*>(j.str().data()), j.str().size()});
 }
 
 void TelemetryStage::OfferImu(const ImuSample& s) { Offer(imu_, s); }

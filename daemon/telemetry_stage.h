@@ -23,6 +23,7 @@ struct LiveStreamReport {
   uint64_t published = 0;
   uint64_t dropped = 0;       // oldest messages dropped for slow clients
   uint64_t protocol_errors = 0;
+  double server_cpu_seconds = 0.0;  // the WebSocket thread, after the stream stopped
 };
 
 class TelemetryStage {
@@ -40,6 +41,8 @@ class TelemetryStage {
   void OfferImu(const ImuSample& s);
   void OfferWheelOdometry(const WheelOdometrySample& s);
   void OfferStereo(const StereoFrame& f);
+  // The daemon's periodic status line, to the live /diagnostics channel (any thread).
+  void PublishDiagnostics(const std::string& status);
 
   bool recording() const { return recorder_ != nullptr; }
   const RecordingReport& recording_report() const { return recorder_->report(); }
@@ -70,6 +73,7 @@ class TelemetryStage {
   std::unique_ptr<McapRecorder> recorder_;
   std::unique_ptr<FoxgloveServer> live_;
   uint32_t live_channel_[kTelemetryTopicCount] = {};
+  uint32_t diagnostics_channel_ = 0;
   int64_t image_every_ = 1;
   uint64_t stereo_seen_ = 0;
   std::atomic<uint64_t> live_published_{0};

@@ -8,6 +8,8 @@
 #include <mutex>
 #include <thread>
 
+#include <sys/resource.h>
+
 #include <websocketpp/config/asio_no_tls.hpp>
 #include <websocketpp/server.hpp>
 
@@ -34,6 +36,7 @@ struct WebSocketServer::Impl {
   std::atomic<uint16_t> port{0};
   std::atomic<uint64_t> dropped{0};
   std::atomic<size_t> clients_connected{0};
+  double cpu_seconds = 0.0;
   std::mutex mutex;  // guards clients and ids
   std::map<uint64_t, Client> clients;
   std::map<Handle, uint64_t, std::owner_less<Handle>> ids;
@@ -177,6 +180,11 @@ bool WebSocketServer::Start(const std::string& address, uint16_t port, const std
     } catch (const std::exception&) {
       // The server thread must not take the daemon down; the stream simply ends.
     }
+    rusage usage{};
+    if (getrusage(RUSAGE_THREAD, &usage) == 0) {
+      s.cpu_seconds = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                      static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec) * 1e-6;
+    }
   });
   return true;
 }
@@ -224,6 +232,8 @@ void WebSocketServer::Close(uint64_t client, const std::string& reason) {
 }
 
 uint64_t WebSocketServer::dropped_messages() const { return impl_->dropped.load(); }
+
+double WebSocketServer::cpu_seconds() const { return impl_->cpu_seconds; }
 
 size_t WebSocketServer::client_count() const { return impl_->clients_connected.load(); }
 

@@ -39,6 +39,8 @@ class WebSocketServer {
   void Close(uint64_t client, const std::string& reason);
 
   uint64_t dropped_messages() const;
+  // CPU time of the server thread, known once Stop() has returned.
+  double cpu_seconds() const;
   size_t client_count() const;
 
  private:
