@@ -29,6 +29,7 @@ Duration LatencyHistogram::Quantile(double q) const {
   for (size_t b = 0; b < buckets_.size(); ++b) {
     seen += buckets_[b];
     if (seen >= std::max<uint64_t>(rank, 1)) {
+      if (b + 1 == buckets_.size()) return max();  // the overflow bucket has no upper edge
       return std::min(Duration::Microseconds(UpperEdgeUs(static_cast<int>(b))), max());
     }
   }

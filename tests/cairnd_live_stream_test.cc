@@ -61,7 +61,8 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
     daemon = testing::RunProcess(
         {testing::BinaryDir() + "/daemon/cairnd", "--config", testing::SourceDir() + "/configs/euroc.yaml",
          "--replay", testing::EurocMicro(), "--out", out, "--set", "live.enabled=true", "--set",
-         "live.port=" + std::to_string(port), "--set", "replay.pacing=realtime", "--set", "live.image_every=2"},
+         "live.port=" + std::to_string(port), "--set", "replay.pacing=realtime", "--set", "live.image_every=2", "--set",
+         "daemon.status_interval=0.25"},
         po);
   });
   bool up = false;
@@ -81,7 +82,7 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   const testing::JsonValue r = testing::JsonValue::Parse(client.output);
   EXPECT_EQ(r["serverInfo"].string(), "cairnd euroc-mav");
   EXPECT_TRUE(r["errors"].array().empty()) << client.output;
-  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image", "/cam1/image"}) {
+  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image", "/cam1/image", "/diagnostics"}) {
     const testing::JsonValue& c = r["channels"][topic];
     EXPECT_GT(c["count"].number(), 0) << topic;
     EXPECT_EQ(c["decodeErrors"].number(), 0) << topic;

@@ -47,7 +47,9 @@ client.on("error", (e) => result.errors.push(String(e?.message ?? e)));
 client.on("advertise", (channels) => {
   for (const ch of channels) {
     try {
-      const type = rootFor(ch).lookupType(ch.schemaName);
+      const type = ch.encoding === "json"
+          ? { decode: (bytes) => JSON.parse(new TextDecoder().decode(bytes)) }
+          : rootFor(ch).lookupType(ch.schemaName);
       const id = client.subscribe(ch.id);
       subs.set(id, { ch, type });
       result.channels[ch.topic] = { schema: ch.schemaName, count: 0, increasing: true, last: null, decodeErrors: 0 };
