@@ -13,6 +13,9 @@ namespace {
 constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
+    {"stereo", "dense disparity of a stereo pair (SGM), written as PFM", RunStereo},
+    {"stereo-eval", "score a disparity PFM against Middlebury/KITTI ground truth (JSON)", RunStereoEval},
+    {"bench stereo", "time our SGM against OpenCV StereoSGBM side by side", RunBenchStereo},
 });
 
 void PrintHelp() {

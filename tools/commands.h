@@ -8,3 +8,11 @@ int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
 
 }  // namespace cairn::tools
+
+namespace cairn::tools {
+
+int RunStereo(const CommandArgs& args);
+int RunStereoEval(const CommandArgs& args);
+int RunBenchStereo(const CommandArgs& args);
+
+}  // namespace cairn::tools

@@ -1,0 +1,90 @@
+#include "fpga/disparity_filter.h"
+
+#include <algorithm>
+#include <cstdlib>
+
+#include "fpga/stereo_matcher_interface.h"
+
+namespace cairn {
+
+void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int height, int y0,
+                                int y1) {
+  for (int y = y0; y < y1; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const size_t i = static_cast<size_t>(y) * width + x;
+      if (in[i] == kInvalidDisparity) {
+        out[i] = kInvalidDisparity;
+        continue;
+      }
+      int16_t v[9];
+      int n = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy) {
+        for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
+          const int16_t d = in[static_cast<size_t>(yy) * width + xx];
+          if (d != kInvalidDisparity) v[n++] = d;
+        }
+      }
+      std::nth_element(v, v + (n - 1) / 2, v + n);
+      out[i] = v[(n - 1) / 2];
+    }
+  }
+}
+
+void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, int max_size,
+                                     int max_diff) {
+  if (max_size <= 0) return;
+  const size_t n = static_cast<size_t>(width) * height;
+  label_.assign(n, 0);  // no reallocation once the size was seen
+  stack_.resize(n);
+  region_.resize(n);
+  for (size_t start = 0; start < n; ++start) {
+    if (label_[start] != 0 || disparity[start] == kInvalidDisparity) continue;
+    // Flood fill, remembering the members so that a small region can be cleared afterwards.
+    int top = 0, count = 0;
+    stack_[top++] = static_cast<int32_t>(start);
+    label_[start] = 1;
+    while (top > 0) {
+      const int32_t p = stack_[--top];
+      region_[count++] = p;
+      const int px = p % width, py = p / width;
+      const int16_t dp = disparity[p];
+      const int32_t nb[4] = {px > 0 ? p - 1 : -1, px + 1 < width ? p + 1 : -1,
+                             py > 0 ? p - width : -1, py + 1 < height ? p + width : -1};
+      for (int32_t q : nb) {
+        if (q < 0 || label_[q] != 0) continue;
+        const int16_t dq = disparity[q];
+        if (dq == kInvalidDisparity || std::abs(dq - dp) > max_diff) continue;
+        label_[q] = 1;
+        stack_[top++] = q;
+      }
+    }
+    if (count < max_size) {
+      for (int i = 0; i < count; ++i) disparity[region_[i]] = kInvalidDisparity;
+    }
+  }
+}
+
+void DisparityFilter::FillHolesRow(int16_t* row, int width) {
+  int x = 0;
+  while (x < width) {
+    if (row[x] != kInvalidDisparity) {
+      ++x;
+      continue;
+    }
+    int end = x;
+    while (end < width && row[end] == kInvalidDisparity) ++end;
+    const bool has_left = x > 0, has_right = end < width;
+    if (has_left || has_right) {
+      int16_t fill;
+      if (has_left && has_right) {
+        fill = std::min(row[x - 1], row[end]);
+      } else {
+        fill = has_left ? row[x - 1] : row[end];
+      }
+      std::fill(row + x, row + end, fill);
+    }
+    x = end;
+  }
+}
+
+}  // namespace cairn

@@ -1,0 +1,152 @@
+// The golden model: plain loops that define SGM's integer arithmetic exactly.
+
+#include <algorithm>
+#include <bit>
+#include <cstdlib>
+
+#include "fpga/sgm_kernels.h"
+
+namespace cairn {
+namespace {
+
+void CensusScalar(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch,
+                  uint32_t* out) {
+  const int rx = cw / 2, ry = ch / 2;
+  for (int x = 0; x < width; ++x) {
+    uint32_t bits = 0;
+    for (int dy = -ry; dy <= 0; ++dy) {
+      for (int dx = -rx; dx <= rx; ++dx) {
+        if (dy == 0 && dx == 0) break;
+        const uint8_t a = center[dy * stride + x + dx];
+        const uint8_t b = center[-dy * stride + x - dx];
+        bits = (bits << 1) | (a > b ? 1u : 0u);
+      }
+    }
+    out[x] = bits;
+  }
+}
+
+void CostScalar(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
+                const SgmRowGeometry& g, uint16_t* cost) {
+  const int d_count = g.disparities;
+  for (int x = 0; x < g.width; ++x) {
+    const int base = g.rev_base - x;
+    for (int k = 0; k < d_count; ++k) {
+      const uint32_t c = static_cast<uint32_t>(std::popcount(left[x] ^ right_rev[base + k]));
+      cost[x * d_count + k] = static_cast<uint16_t>(std::max(c, border[base + k]));
+    }
+  }
+}
+
+// One SGM recursion step: out[k] = C[k] + min(prev[k], prev[k+-1] + P1, min_prev + P2) - min_prev.
+// Returns min_k out[k].
+uint16_t Step(const uint16_t* c, const uint16_t* prev, uint16_t min_prev, uint16_t p1,
+              uint16_t p2, int d_count, uint16_t* out) {
+  const auto sat_add = [](uint16_t a, uint16_t b) {
+    return static_cast<uint16_t>(std::min<uint32_t>(uint32_t{a} + b, 0xFFFFu));
+  };
+  const uint16_t jump = sat_add(min_prev, p2);
+  uint16_t best = 0xFFFF;
+  for (int k = 0; k < d_count; ++k) {
+    uint16_t m = std::min(prev[k], std::min(sat_add(prev[k - 1], p1), sat_add(prev[k + 1], p1)));
+    m = std::min(m, jump);
+    out[k] = static_cast<uint16_t>(c[k] + (m - min_prev));
+    best = std::min(best, out[k]);
+  }
+  return best;
+}
+
+void HorizontalScalar(const uint16_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                      const uint16_t* p2_table, uint16_t p1, uint16_t* scratch, uint16_t* sum) {
+  const int d_count = g.disparities;
+  uint16_t* a = scratch + kPathPad;
+  uint16_t* b = scratch + g.block + kPathPad;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::fill(a, a + d_count, uint16_t{0});
+    uint16_t min_prev = 0;
+    int prev_x = pass == 0 ? 0 : g.width - 1;
+    for (int i = 0; i < g.width; ++i) {
+      const int x = pass == 0 ? i : g.width - 1 - i;
+      const uint16_t p2 = p2_table[std::abs(image_row[x] - image_row[prev_x])];
+      min_prev = Step(cost + x * d_count, a, min_prev, p1, p2, d_count, b);
+      uint16_t* s = sum + x * d_count;
+      for (int k = 0; k < d_count; ++k) s[k] = static_cast<uint16_t>(pass == 0 ? b[k] : s[k] + b[k]);
+      std::swap(a, b);
+      prev_x = x;
+    }
+  }
+}
+
+void VerticalScalar(const uint16_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
+                    const SgmRowGeometry& g, int paths, const uint16_t* p2_table, uint16_t p1,
+                    uint16_t* const* prev, const uint16_t* const* prev_min, uint16_t* const* cur,
+                    uint16_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+  const int d_count = g.disparities;
+  static constexpr int kOffsets[3] = {0, -1, 1};
+  // A path entering the image starts from zero costs, which makes its first step return C.
+  uint16_t zero_block[512 + 2 * kPathPad];
+  std::fill(zero_block, zero_block + g.block, uint16_t{0});
+  zero_block[kPathPad - 1] = kPathSentinel;
+  zero_block[kPathPad + d_count] = kPathSentinel;
+  const uint16_t* zero = zero_block + kPathPad;
+  for (int x = 0; x < g.width; ++x) {
+    for (int k = 0; k < d_count; ++k) dst[x * d_count + k] = src[x * d_count + k];
+    for (int p = 0; p < paths; ++p) {
+      const int px = x + kOffsets[p];
+      const bool inside = prev != nullptr && px >= 0 && px < g.width;
+      const uint16_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
+      const uint16_t mp = inside ? prev_min[p][px] : 0;
+      const uint16_t p2 = inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
+      uint16_t* out = cur[p] + x * g.block + kPathPad;
+      cur_min[p][x] = Step(cost + x * d_count, lp, mp, p1, p2, d_count, out);
+      for (int k = 0; k < d_count; ++k) {
+        dst[x * d_count + k] = static_cast<uint16_t>(dst[x * d_count + k] + out[k]);
+      }
+    }
+  }
+}
+
+void WtaScalar(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent,
+               uint16_t* scratch, int16_t* best, int16_t* right_best) {
+  const int d_count = g.disparities;
+  const int n_rev = g.rev_base + d_count;
+  uint16_t* rmin = scratch;
+  uint16_t* rk = scratch + n_rev;
+  std::fill(rmin, rmin + n_rev, uint16_t{0x7FFF});
+  std::fill(rk, rk + n_rev, uint16_t{0xFFFF});
+  for (int x = 0; x < g.width; ++x) {
+    const uint16_t* s = sum + x * d_count;
+    int bk = 0;
+    for (int k = 1; k < d_count; ++k) {
+      if (s[k] < s[bk]) bk = k;
+    }
+    uint32_t second = 0xFFFF;
+    for (int k = 0; k < d_count; ++k) {
+      if (k < bk - 1 || k > bk + 1) second = std::min<uint32_t>(second, s[k]);
+    }
+    const bool unique = second * static_cast<uint32_t>(100 - uniqueness_percent) >=
+                        uint32_t{s[bk]} * 100u;
+    best[x] = static_cast<int16_t>(unique ? bk : -1 - bk);
+    const int base = g.rev_base - x;
+    for (int k = 0; k < d_count; ++k) {
+      if (s[k] < rmin[base + k]) {
+        rmin[base + k] = s[k];
+        rk[base + k] = static_cast<uint16_t>(k);
+      }
+    }
+  }
+  for (int xr = 0; xr < g.width; ++xr) {
+    const uint16_t k = rk[g.rev_base - g.min_disparity - xr];
+    right_best[xr] = k == 0xFFFF ? int16_t{-1} : static_cast<int16_t>(k);
+  }
+}
+
+}  // namespace
+
+const SgmKernels& ScalarSgmKernels() {
+  static const SgmKernels kernels{CensusScalar, CostScalar, HorizontalScalar, VerticalScalar,
+                                  WtaScalar};
+  return kernels;
+}
+
+}  // namespace cairn
