@@ -3,17 +3,20 @@
 // per-pixel decisions; a backend only supplies these loops. The scalar set is the golden model;
 // the Highway set must give the same result for every input (all arithmetic is integer).
 //
-// Layouts: a cost or sum row is width * D uint16 (disparity index k fastest, k = d - d_min). A
-// path row holds one block of `block` uint16 per pixel whose lanes [0, D) are the path costs and
-// whose lanes -1 and D hold kPathSentinel, so the +-1 neighbours read there never win.
+// Layouts: a cost row is width * D uint8 and a sum row width * D uint16 (disparity index k
+// fastest, k = d - d_min). A path row holds one block of `block` uint8 per pixel whose lanes
+// [0, D) are the path costs and whose lanes -1 and D hold kPathSentinel, so the +-1 neighbours
+// read there never win. Path costs fit 8 bits because SgmOptions::Validate demands
+// census_bits + 2 * p2 <= 255: a path cost is at most C + P2 and the jump term min + P2 at most
+// census_bits + 2 * P2, so no addition overflows and none saturates.
 
 #include <cstddef>
 #include <cstdint>
 
 namespace cairn {
 
-inline constexpr uint16_t kPathSentinel = 0xFFFF;
-inline constexpr int kPathPad = 32;  // lanes before and after each path block (keeps alignment)
+inline constexpr uint8_t kPathSentinel = 0xFF;
+inline constexpr int kPathPad = 64;  // lanes before and after each path block (keeps alignment)
 
 struct SgmRowGeometry {
   int width = 0;
@@ -32,16 +35,16 @@ struct SgmKernels {
                  uint32_t* out);
   // cost[x*D + k] = max(popcount(left[x] ^ right_rev[i]), border[i]), i = rev_base - x + k.
   void (*cost)(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-               const SgmRowGeometry& g, uint16_t* cost);
-  // Left-to-right path written to sum, then right-to-left added. scratch: 2 path blocks.
-  void (*horizontal)(const uint16_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                     const uint16_t* p2_table, uint16_t p1, uint16_t* scratch, uint16_t* sum);
+               const SgmRowGeometry& g, uint8_t* cost);
+  // The left-to-right and right-to-left paths; sum = their sum. scratch: 4 path blocks.
+  void (*horizontal)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                     const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum);
   // `paths` (1 or 3) paths arriving from the previous row at x, x-1, x+1. prev == nullptr on the
   // first row of a sweep. dst[x*D + k] = src[...] + sum of the new path costs (dst may be src).
-  void (*vertical)(const uint16_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
-                   const SgmRowGeometry& g, int paths, const uint16_t* p2_table, uint16_t p1,
-                   uint16_t* const* prev, const uint16_t* const* prev_min, uint16_t* const* cur,
-                   uint16_t* const* cur_min, const uint16_t* src, uint16_t* dst);
+  void (*vertical)(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
+                   const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
+                   uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
+                   uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst);
   // Winner-take-all of one sum row. best[x] = argmin_k (smallest k on ties), or -1 - best when
   // the uniqueness test fails. right_best[xr] = argmin_k sum(xr + d_min + k, k) over the row, -1
   // where no candidate exists. scratch: 2 * (rev_base + D + 1) uint16.

@@ -1,6 +1,7 @@
 #include "fpga/sgm_matcher.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -36,7 +37,7 @@ SgmMatcher::SgmMatcher(const SgmOptions& options)
   const int s = static_cast<int>(options.p2_intensity_scale);
   for (int di = 0; di < 256; ++di) {
     const int v = s > 0 ? std::max(p1 + 1, p2 * s / (s + di)) : p2;
-    p2_table_[di] = static_cast<uint16_t>(v);
+    p2_table_[di] = static_cast<uint8_t>(v);
   }
 }
 
@@ -70,17 +71,17 @@ void SgmMatcher::Allocate(int width, int height) {
   filtered_ = AllocateBuffer<int16_t>(w * h, &buffer_bytes_);
   const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
   for (Sweep& s : sweeps_) {
-    s.cost = AllocateBuffer<uint16_t>(w * d, &buffer_bytes_);
+    s.cost = AllocateBuffer<uint8_t>(w * d, &buffer_bytes_);
     s.row_sum = AllocateBuffer<uint16_t>(w * d, &buffer_bytes_);
-    s.horizontal_scratch = AllocateBuffer<uint16_t>(2 * geometry_.block, &buffer_bytes_);
+    s.horizontal_scratch = AllocateBuffer<uint8_t>(4 * geometry_.block, &buffer_bytes_);
     s.wta_scratch = AllocateBuffer<uint16_t>(2 * n_rev, &buffer_bytes_);
-    std::fill_n(s.horizontal_scratch.get(), 2 * geometry_.block, kPathSentinel);
+    std::fill_n(s.horizontal_scratch.get(), 4 * geometry_.block, kPathSentinel);
     for (int b = 0; b < 2; ++b) {
       for (int p = 0; p < 3; ++p) {
         // Sentinels fill the block pads once; the kernels only ever write lanes [0, D).
-        s.path[b][p] = AllocateBuffer<uint16_t>(w * geometry_.block, &buffer_bytes_);
+        s.path[b][p] = AllocateBuffer<uint8_t>(w * geometry_.block, &buffer_bytes_);
         std::fill_n(s.path[b][p].get(), w * geometry_.block, kPathSentinel);
-        s.path_min[b][p] = AllocateBuffer<uint16_t>(w, &buffer_bytes_);
+        s.path_min[b][p] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
       }
     }
     s.right_rev = AllocateBuffer<uint32_t>(n_rev, &buffer_bytes_);
@@ -121,7 +122,7 @@ void SgmMatcher::ComputeCost(Sweep& s, int y) {
 
 void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
   const SgmRowGeometry& g = geometry_;
-  const uint16_t p1 = static_cast<uint16_t>(options_.p1);
+  const uint8_t p1 = static_cast<uint8_t>(options_.p1);
   const int paths = options_.paths == 8 ? 3 : 1;
   ComputeCost(s, y);
   uint16_t* sum_row = sum_.get() + static_cast<size_t>(y) * width_ * g.disparities;
@@ -130,10 +131,10 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
                          s.horizontal_scratch.get(), sum_row);
   }
   const int prev = 1 - s.cur;
-  uint16_t* prev_paths[3];
-  const uint16_t* prev_min[3];
-  uint16_t* cur_paths[3];
-  uint16_t* cur_min[3];
+  uint8_t* prev_paths[3];
+  const uint8_t* prev_min[3];
+  uint8_t* cur_paths[3];
+  uint8_t* cur_min[3];
   for (int p = 0; p < 3; ++p) {
     prev_paths[p] = s.path[prev][p].get();
     prev_min[p] = s.path_min[prev][p].get();
@@ -232,6 +233,13 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
     output->depth.resize(n);
     output->depth_sigma.resize(n);
   }
+  using Clock = std::chrono::steady_clock;
+  auto mark = Clock::now();
+  const auto lap = [&mark](double* ms) {
+    const auto now = Clock::now();
+    *ms = std::chrono::duration<double, std::milli>(now - mark).count();
+    mark = now;
+  };
   const int tasks = pool_.threads();
   const auto band = [&](int t, int count, int* y0, int* y1) {
     *y0 = static_cast<int>(static_cast<int64_t>(count) * t / tasks);
@@ -258,6 +266,7 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
     }
   });
 
+  lap(&times_.census_ms);
   // The two sweeps (see the header): sweep 0 top-down, sweep 1 bottom-up.
   const int half = h / 2;
   for (Sweep& s : sweeps_) s.has_prev = false;
@@ -268,6 +277,7 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
       for (int y = h - 1; y >= half; --y) SweepRow(sweeps_[1], y, false);
     }
   });
+  lap(&times_.first_half_ms);
   pool_.ForEach(2, [&](int t) {
     if (t == 0) {
       for (int y = half; y < h; ++y) SweepRow(sweeps_[0], y, true);
@@ -276,6 +286,7 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
     }
   });
 
+  lap(&times_.second_half_ms);
   // Post-filters, shared by every backend.
   int16_t* disp = raw_.get();
   if (options_.median) {
@@ -286,17 +297,20 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
     });
     disp = filtered_.get();
   }
+  lap(&times_.median_ms);
   filter_.RemoveSpeckles(disp, w, h, static_cast<int>(options_.speckle_max_size),
                          static_cast<int>(options_.speckle_max_diff));
   if (options_.fill_holes) {
     for (int y = 0; y < h; ++y) DisparityFilter::FillHolesRow(disp + static_cast<size_t>(y) * w, w);
   }
+  lap(&times_.speckle_ms);
   std::copy(disp, disp + n, output->disparity.begin());
   pool_.ForEach(tasks, [&](int t) {
     int y0, y1;
     band(t, h, &y0, &y1);
     ComputeDepth(input, output, y0, y1);
   });
+  lap(&times_.depth_ms);
   return Status::Ok();
 }
 

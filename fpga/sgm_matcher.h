@@ -35,14 +35,22 @@ class SgmMatcher final : public StereoMatcher {
   // Bytes held for the current image size.
   size_t buffer_bytes() const { return buffer_bytes_; }
 
+  // Wall time of the stages of the last Match(), for benchmarks.
+  struct StageTimes {
+    double census_ms = 0, first_half_ms = 0, second_half_ms = 0, median_ms = 0, speckle_ms = 0,
+           depth_ms = 0;
+  };
+  const StageTimes& last_stage_times() const { return times_; }
+
  private:
   template <class T>
   using Buffer = hwy::AlignedFreeUniquePtr<T[]>;
 
   struct Sweep {
-    Buffer<uint16_t> cost, row_sum, horizontal_scratch, wta_scratch;
-    Buffer<uint16_t> path[2][3];  // [prev/cur][path]
-    Buffer<uint16_t> path_min[2][3];
+    Buffer<uint8_t> cost, horizontal_scratch;
+    Buffer<uint16_t> row_sum, wta_scratch;
+    Buffer<uint8_t> path[2][3];  // [prev/cur][path]
+    Buffer<uint8_t> path_min[2][3];
     Buffer<uint32_t> right_rev, border;
     Buffer<int16_t> best, right_best;
     int cur = 0;          // which of path[0], path[1] receives the next row
@@ -64,7 +72,7 @@ class SgmMatcher final : public StereoMatcher {
   SgmOptions options_;
   const SgmKernels* kernels_;
   WorkerPool pool_;
-  uint16_t p2_table_[256];
+  uint8_t p2_table_[256];
   int rx_ = 0, ry_ = 0;
 
   int width_ = 0, height_ = 0;
@@ -77,6 +85,7 @@ class SgmMatcher final : public StereoMatcher {
   Sweep sweeps_[2];
   DisparityFilter filter_;
   size_t buffer_bytes_ = 0;
+  StageTimes times_;
 };
 
 }  // namespace cairn

@@ -25,6 +25,12 @@ Status SgmOptions::Validate() const {
     return InvalidArgumentError("sgm p2 (" + std::to_string(p2) + ") must exceed p1 (" +
                                 std::to_string(p1) + ")");
   }
+  if (census_bits() + 2 * p2 > 255) {
+    // Keeps every path cost within 8 bits (see fpga/sgm_kernels.h).
+    return InvalidArgumentError("sgm p2 (" + std::to_string(p2) + ") must be at most (255 - " +
+                                std::to_string(census_bits()) + " census bits) / 2 = " +
+                                std::to_string((255 - census_bits()) / 2));
+  }
   return Status::Ok();
 }
 

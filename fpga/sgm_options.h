@@ -17,7 +17,7 @@ struct SgmOptions {
   int64_t census_height = 7;
   int64_t paths = 4;               // 4 (horizontal + vertical) or 8 (plus diagonals)
   int64_t p1 = 7;                  // penalty for a disparity change of 1 px
-  int64_t p2 = 100;                // penalty for larger changes in flat regions
+  int64_t p2 = 100;                // penalty for larger changes; census bits + 2 p2 <= 255
   // P2 falls to p2 * s / (s + |dI|) across an intensity step dI (but not below p1 + 1): depth
   // edges usually coincide with intensity edges. 0 keeps P2 constant.
   int64_t p2_intensity_scale = 16;  // gray levels
@@ -40,7 +40,7 @@ struct SgmOptions {
     v.Integer("census_height", census_height, 3, 13, "px");
     v.Integer("paths", paths, 4, 8, "");
     v.Integer("p1", p1, 1, 255, "cost");
-    v.Integer("p2", p2, 2, 1023, "cost");
+    v.Integer("p2", p2, 2, 127, "cost");
     v.Integer("p2_intensity_scale", p2_intensity_scale, 0, 255, "gray levels");
     v.Integer("uniqueness_percent", uniqueness_percent, 0, 99, "%");
     v.Flag("lr_check", lr_check);

@@ -27,47 +27,47 @@ void CensusScalar(const uint8_t* center, ptrdiff_t stride, int width, int cw, in
 }
 
 void CostScalar(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-                const SgmRowGeometry& g, uint16_t* cost) {
+                const SgmRowGeometry& g, uint8_t* cost) {
   const int d_count = g.disparities;
   for (int x = 0; x < g.width; ++x) {
     const int base = g.rev_base - x;
     for (int k = 0; k < d_count; ++k) {
       const uint32_t c = static_cast<uint32_t>(std::popcount(left[x] ^ right_rev[base + k]));
-      cost[x * d_count + k] = static_cast<uint16_t>(std::max(c, border[base + k]));
+      cost[x * d_count + k] = static_cast<uint8_t>(std::max(c, border[base + k]));
     }
   }
 }
 
-// One SGM recursion step: out[k] = C[k] + min(prev[k], prev[k+-1] + P1, min_prev + P2) - min_prev.
-// Returns min_k out[k].
-uint16_t Step(const uint16_t* c, const uint16_t* prev, uint16_t min_prev, uint16_t p1,
-              uint16_t p2, int d_count, uint16_t* out) {
-  const auto sat_add = [](uint16_t a, uint16_t b) {
-    return static_cast<uint16_t>(std::min<uint32_t>(uint32_t{a} + b, 0xFFFFu));
+// One SGM recursion step: out[k] = C[k] + min(prev[k], prev[k+-1] + P1, min_prev + P2) - min_prev,
+// additions saturating at 255 (which only the sentinels reach). Returns min_k out[k].
+uint8_t Step(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uint8_t p1, uint8_t p2,
+             int d_count, uint8_t* out) {
+  const auto sat_add = [](uint8_t a, uint8_t b) {
+    return static_cast<uint8_t>(std::min(a + b, 255));
   };
-  const uint16_t jump = sat_add(min_prev, p2);
-  uint16_t best = 0xFFFF;
+  const uint8_t jump = sat_add(min_prev, p2);
+  uint8_t best = 0xFF;
   for (int k = 0; k < d_count; ++k) {
-    uint16_t m = std::min(prev[k], std::min(sat_add(prev[k - 1], p1), sat_add(prev[k + 1], p1)));
+    uint8_t m = std::min(prev[k], std::min(sat_add(prev[k - 1], p1), sat_add(prev[k + 1], p1)));
     m = std::min(m, jump);
-    out[k] = static_cast<uint16_t>(c[k] + (m - min_prev));
+    out[k] = static_cast<uint8_t>(c[k] + (m - min_prev));
     best = std::min(best, out[k]);
   }
   return best;
 }
 
-void HorizontalScalar(const uint16_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                      const uint16_t* p2_table, uint16_t p1, uint16_t* scratch, uint16_t* sum) {
+void HorizontalScalar(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
   const int d_count = g.disparities;
-  uint16_t* a = scratch + kPathPad;
-  uint16_t* b = scratch + g.block + kPathPad;
+  uint8_t* a = scratch + kPathPad;
+  uint8_t* b = scratch + g.block + kPathPad;
   for (int pass = 0; pass < 2; ++pass) {
-    std::fill(a, a + d_count, uint16_t{0});
-    uint16_t min_prev = 0;
+    std::fill(a, a + d_count, uint8_t{0});
+    uint8_t min_prev = 0;
     int prev_x = pass == 0 ? 0 : g.width - 1;
     for (int i = 0; i < g.width; ++i) {
       const int x = pass == 0 ? i : g.width - 1 - i;
-      const uint16_t p2 = p2_table[std::abs(image_row[x] - image_row[prev_x])];
+      const uint8_t p2 = p2_table[std::abs(image_row[x] - image_row[prev_x])];
       min_prev = Step(cost + x * d_count, a, min_prev, p1, p2, d_count, b);
       uint16_t* s = sum + x * d_count;
       for (int k = 0; k < d_count; ++k) s[k] = static_cast<uint16_t>(pass == 0 ? b[k] : s[k] + b[k]);
@@ -77,27 +77,27 @@ void HorizontalScalar(const uint16_t* cost, const uint8_t* image_row, const SgmR
   }
 }
 
-void VerticalScalar(const uint16_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
-                    const SgmRowGeometry& g, int paths, const uint16_t* p2_table, uint16_t p1,
-                    uint16_t* const* prev, const uint16_t* const* prev_min, uint16_t* const* cur,
-                    uint16_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+void VerticalScalar(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
+                    const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
+                    uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
+                    uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
   const int d_count = g.disparities;
   static constexpr int kOffsets[3] = {0, -1, 1};
   // A path entering the image starts from zero costs, which makes its first step return C.
-  uint16_t zero_block[512 + 2 * kPathPad];
-  std::fill(zero_block, zero_block + g.block, uint16_t{0});
+  uint8_t zero_block[512 + 2 * kPathPad];
+  std::fill(zero_block, zero_block + g.block, uint8_t{0});
   zero_block[kPathPad - 1] = kPathSentinel;
   zero_block[kPathPad + d_count] = kPathSentinel;
-  const uint16_t* zero = zero_block + kPathPad;
+  const uint8_t* zero = zero_block + kPathPad;
   for (int x = 0; x < g.width; ++x) {
     for (int k = 0; k < d_count; ++k) dst[x * d_count + k] = src[x * d_count + k];
     for (int p = 0; p < paths; ++p) {
       const int px = x + kOffsets[p];
       const bool inside = prev != nullptr && px >= 0 && px < g.width;
-      const uint16_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
-      const uint16_t mp = inside ? prev_min[p][px] : 0;
-      const uint16_t p2 = inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
-      uint16_t* out = cur[p] + x * g.block + kPathPad;
+      const uint8_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
+      const uint8_t mp = inside ? prev_min[p][px] : 0;
+      const uint8_t p2 = inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
+      uint8_t* out = cur[p] + x * g.block + kPathPad;
       cur_min[p][x] = Step(cost + x * d_count, lp, mp, p1, p2, d_count, out);
       for (int k = 0; k < d_count; ++k) {
         dst[x * d_count + k] = static_cast<uint16_t>(dst[x * d_count + k] + out[k]);

@@ -1,6 +1,7 @@
 // Highway implementation of the SGM row kernels, compiled once per target and dispatched at run
-// time. Every loop mirrors sgm_scalar_kernels.cc lane for lane; vectors are capped at 16 lanes so
-// that the disparity count (a multiple of 16) is always a whole number of vectors.
+// time. Every loop mirrors sgm_scalar_kernels.cc lane for lane. Loops over disparities use full
+// vectors when the disparity count is a multiple of their length, else 16 lanes (the count is
+// always a multiple of 16).
 
 #include <algorithm>
 #include <bit>
@@ -18,8 +19,6 @@ namespace cairn {
 namespace HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-using D16 = hn::CappedTag<uint16_t, 16>;
-using DI16 = hn::CappedTag<int16_t, 16>;
 using DI32 = hn::CappedTag<int32_t, 16>;
 using D32 = hn::CappedTag<uint32_t, 16>;
 
@@ -58,35 +57,39 @@ static void CensusSimd(const uint8_t* center, ptrdiff_t stride, int width, int c
 }
 
 static void CostSimd(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-                     const SgmRowGeometry& g, uint16_t* cost) {
+                     const SgmRowGeometry& g, uint8_t* cost) {
   const D32 du;
   const DI32 di;
-  const hn::Rebind<uint16_t, DI32> d16;
+  const hn::Rebind<uint8_t, DI32> d8;
   const int n = static_cast<int>(hn::Lanes(du));
   const int d_count = g.disparities;
   for (int x = 0; x < g.width; ++x) {
     const auto vl = hn::Set(du, left[x]);
     const int base = g.rev_base - x;
-    uint16_t* out = cost + x * d_count;
+    uint8_t* out = cost + x * d_count;
     for (int k = 0; k < d_count; k += n) {
       const auto pc = hn::PopulationCount(hn::Xor(vl, hn::LoadU(du, right_rev + base + k)));
       const auto c = hn::Max(pc, hn::LoadU(du, border + base + k));
-      hn::StoreU(hn::DemoteTo(d16, hn::BitCast(di, c)), d16, out + k);
+      hn::StoreU(hn::DemoteTo(d8, hn::BitCast(di, c)), d8, out + k);
     }
   }
 }
 
-// One SGM recursion step (see Step in sgm_scalar_kernels.cc); dst[k] = (src ? src[k] : 0) + out[k].
-template <bool kAddSrc>
-HWY_INLINE uint16_t StepSimd(const uint16_t* c, const uint16_t* prev, uint16_t min_prev,
-                             uint16_t p1, uint16_t p2, int d_count, uint16_t* out,
-                             const uint16_t* src, uint16_t* dst) {
-  const D16 d;
+// One SGM recursion step (see Step in sgm_scalar_kernels.cc), on 8-bit lanes; also
+// dst[k] = (kAddSrc ? src[k] : 0) + out[k] in 16 bits.
+template <bool kAddSrc, class D8>
+HWY_INLINE uint8_t StepSimd(D8 d, const uint8_t* c, const uint8_t* prev, uint8_t min_prev,
+                            uint8_t p1, uint8_t p2, int d_count, uint8_t* out,
+                            const uint16_t* src, uint16_t* dst) {
+#if HWY_TARGET != HWY_SCALAR
+  const hn::Half<D8> dh;
+  const hn::Rebind<uint16_t, decltype(dh)> dw;
+#endif
   const int n = static_cast<int>(hn::Lanes(d));
   const auto vp1 = hn::Set(d, p1);
   const auto vmp = hn::Set(d, min_prev);
   const auto jump = hn::SaturatedAdd(vmp, hn::Set(d, p2));
-  auto best = hn::Set(d, uint16_t{0xFFFF});
+  auto best = hn::Set(d, uint8_t{0xFF});
   for (int k = 0; k < d_count; k += n) {
     const auto pv = hn::LoadU(d, prev + k);
     const auto lm = hn::SaturatedAdd(hn::LoadU(d, prev + k - 1), vp1);
@@ -95,68 +98,115 @@ HWY_INLINE uint16_t StepSimd(const uint16_t* c, const uint16_t* prev, uint16_t m
     const auto o = hn::Add(hn::LoadU(d, c + k), hn::Sub(m, vmp));
     hn::StoreU(o, d, out + k);
     best = hn::Min(best, o);
+#if HWY_TARGET == HWY_SCALAR  // one lane: nothing to split
+    dst[k] = static_cast<uint16_t>((kAddSrc ? src[k] : 0) + out[k]);
+  }
+  return hn::GetLane(best);
+#else
+    const int nh = n / 2;
+    auto lo = hn::PromoteTo(dw, hn::LowerHalf(dh, o));
+    auto hi = hn::PromoteTo(dw, hn::UpperHalf(dh, o));
     if constexpr (kAddSrc) {
-      hn::StoreU(hn::Add(hn::LoadU(d, src + k), o), d, dst + k);
-    } else {
-      hn::StoreU(o, d, dst + k);
+      lo = hn::Add(lo, hn::LoadU(dw, src + k));
+      hi = hn::Add(hi, hn::LoadU(dw, src + k + nh));
     }
+    hn::StoreU(lo, dw, dst + k);
+    hn::StoreU(hi, dw, dst + k + nh);
   }
-  return hn::GetLane(hn::MinOfLanes(d, best));
+  const auto bw = hn::Min(hn::PromoteTo(dw, hn::LowerHalf(dh, best)),
+                          hn::PromoteTo(dw, hn::UpperHalf(dh, best)));
+  return static_cast<uint8_t>(hn::GetLane(hn::MinOfLanes(dw, bw)));
+#endif
 }
 
-static void HorizontalSimd(const uint16_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                           const uint16_t* p2_table, uint16_t p1, uint16_t* scratch,
-                           uint16_t* sum) {
+// Both directions advance in the same loop: each step waits for the previous pixel's minimum,
+// so two independent chains keep the core busy. The first of the two to reach a pixel writes its
+// sum, the second adds.
+template <class D8>
+void HorizontalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                    const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
   const int d_count = g.disparities;
-  uint16_t* a = scratch + kPathPad;
-  uint16_t* b = scratch + g.block + kPathPad;
-  for (int pass = 0; pass < 2; ++pass) {
-    std::fill(a, a + d_count, uint16_t{0});
-    uint16_t min_prev = 0;
-    int prev_x = pass == 0 ? 0 : g.width - 1;
-    for (int i = 0; i < g.width; ++i) {
-      const int x = pass == 0 ? i : g.width - 1 - i;
-      const uint16_t p2 = p2_table[std::abs(image_row[x] - image_row[prev_x])];
-      uint16_t* s = sum + x * d_count;
-      min_prev = pass == 0 ? StepSimd<false>(cost + x * d_count, a, min_prev, p1, p2, d_count, b, s, s)
-                           : StepSimd<true>(cost + x * d_count, a, min_prev, p1, p2, d_count, b, s, s);
-      std::swap(a, b);
-      prev_x = x;
-    }
+  const int w = g.width;
+  uint8_t* a0 = scratch + kPathPad;
+  uint8_t* b0 = scratch + g.block + kPathPad;
+  uint8_t* a1 = scratch + 2 * g.block + kPathPad;
+  uint8_t* b1 = scratch + 3 * g.block + kPathPad;
+  std::fill(a0, a0 + d_count, uint8_t{0});
+  std::fill(a1, a1 + d_count, uint8_t{0});
+  uint8_t min0 = 0, min1 = 0;
+  for (int i = 0; i < w; ++i) {
+    const int x0 = i, x1 = w - 1 - i;
+    const uint8_t p20 = p2_table[std::abs(image_row[x0] - image_row[i > 0 ? x0 - 1 : x0])];
+    const uint8_t p21 = p2_table[std::abs(image_row[x1] - image_row[i > 0 ? x1 + 1 : x1])];
+    uint16_t* s0 = sum + x0 * d_count;
+    uint16_t* s1 = sum + x1 * d_count;
+    min0 = x0 <= x1 ? StepSimd<false>(d, cost + x0 * d_count, a0, min0, p1, p20, d_count, b0, s0, s0)
+                    : StepSimd<true>(d, cost + x0 * d_count, a0, min0, p1, p20, d_count, b0, s0, s0);
+    min1 = x1 > x0 ? StepSimd<false>(d, cost + x1 * d_count, a1, min1, p1, p21, d_count, b1, s1, s1)
+                   : StepSimd<true>(d, cost + x1 * d_count, a1, min1, p1, p21, d_count, b1, s1, s1);
+    std::swap(a0, b0);
+    std::swap(a1, b1);
   }
 }
 
-static void VerticalSimd(const uint16_t* cost, const uint8_t* image_row,
-                         const uint8_t* prev_image_row, const SgmRowGeometry& g, int paths,
-                         const uint16_t* p2_table, uint16_t p1, uint16_t* const* prev,
-                         const uint16_t* const* prev_min, uint16_t* const* cur,
-                         uint16_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+template <class D8>
+void VerticalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
+                  const uint8_t* prev_image_row, const SgmRowGeometry& g, int paths,
+                  const uint8_t* p2_table, uint8_t p1, uint8_t* const* prev,
+                  const uint8_t* const* prev_min, uint8_t* const* cur, uint8_t* const* cur_min,
+                  const uint16_t* src, uint16_t* dst) {
   const int d_count = g.disparities;
   static constexpr int kOffsets[3] = {0, -1, 1};
-  HWY_ALIGN uint16_t zero_block[512 + 2 * kPathPad];
-  std::fill(zero_block, zero_block + g.block, uint16_t{0});
+  HWY_ALIGN uint8_t zero_block[512 + 2 * kPathPad];
+  std::fill(zero_block, zero_block + g.block, uint8_t{0});
   zero_block[kPathPad - 1] = kPathSentinel;
   zero_block[kPathPad + d_count] = kPathSentinel;
-  const uint16_t* zero = zero_block + kPathPad;
+  const uint8_t* zero = zero_block + kPathPad;
   for (int x = 0; x < g.width; ++x) {
     for (int p = 0; p < paths; ++p) {
       const int px = x + kOffsets[p];
       const bool inside = prev != nullptr && px >= 0 && px < g.width;
-      const uint16_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
-      const uint16_t mp = inside ? prev_min[p][px] : 0;
-      const uint16_t p2 =
+      const uint8_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
+      const uint8_t mp = inside ? prev_min[p][px] : 0;
+      const uint8_t p2 =
           inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
-      uint16_t* out = cur[p] + x * g.block + kPathPad;
+      uint8_t* out = cur[p] + x * g.block + kPathPad;
       const uint16_t* s = p == 0 ? src + x * d_count : dst + x * d_count;
-      cur_min[p][x] = StepSimd<true>(cost + x * d_count, lp, mp, p1, p2, d_count, out, s,
+      cur_min[p][x] = StepSimd<true>(d, cost + x * d_count, lp, mp, p1, p2, d_count, out, s,
                                      dst + x * d_count);
     }
   }
 }
 
-static void WtaSimd(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent,
-                    uint16_t* scratch, int16_t* best, int16_t* right_best) {
-  const DI16 d;
+// Full vectors when the disparity count is a multiple of their length, else 16 lanes.
+static void HorizontalSimd(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                           const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
+  const hn::ScalableTag<uint8_t> full;
+  if (g.disparities % static_cast<int>(hn::Lanes(full)) == 0) {
+    HorizontalImpl(full, cost, image_row, g, p2_table, p1, scratch, sum);
+  } else {
+    HorizontalImpl(hn::CappedTag<uint8_t, 16>(), cost, image_row, g, p2_table, p1, scratch, sum);
+  }
+}
+
+static void VerticalSimd(const uint8_t* cost, const uint8_t* image_row,
+                         const uint8_t* prev_image_row, const SgmRowGeometry& g, int paths,
+                         const uint8_t* p2_table, uint8_t p1, uint8_t* const* prev,
+                         const uint8_t* const* prev_min, uint8_t* const* cur,
+                         uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+  const hn::ScalableTag<uint8_t> full;
+  if (g.disparities % static_cast<int>(hn::Lanes(full)) == 0) {
+    VerticalImpl(full, cost, image_row, prev_image_row, g, paths, p2_table, p1, prev, prev_min,
+                 cur, cur_min, src, dst);
+  } else {
+    VerticalImpl(hn::CappedTag<uint8_t, 16>(), cost, image_row, prev_image_row, g, paths, p2_table,
+                 p1, prev, prev_min, cur, cur_min, src, dst);
+  }
+}
+
+template <class DI>
+void WtaImpl(DI d, const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent,
+             uint16_t* scratch, int16_t* best, int16_t* right_best) {
   const int n = static_cast<int>(hn::Lanes(d));
   const int d_count = g.disparities;
   const int n_rev = g.rev_base + d_count;
@@ -202,6 +252,16 @@ static void WtaSimd(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness
   for (int xr = 0; xr < g.width; ++xr) right_best[xr] = rk[g.rev_base - g.min_disparity - xr];
 }
 
+static void WtaSimd(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent,
+                    uint16_t* scratch, int16_t* best, int16_t* right_best) {
+  const hn::ScalableTag<int16_t> full;
+  if (g.disparities % static_cast<int>(hn::Lanes(full)) == 0) {
+    WtaImpl(full, sum, g, uniqueness_percent, scratch, best, right_best);
+  } else {
+    WtaImpl(hn::CappedTag<int16_t, 16>(), sum, g, uniqueness_percent, scratch, best, right_best);
+  }
+}
+
 static int64_t TargetSimd() { return HWY_TARGET; }
 
 }  // namespace HWY_NAMESPACE
@@ -223,17 +283,17 @@ void Census(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch, 
   HWY_DYNAMIC_DISPATCH(CensusSimd)(center, stride, width, cw, ch, out);
 }
 void Cost(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-          const SgmRowGeometry& g, uint16_t* cost) {
+          const SgmRowGeometry& g, uint8_t* cost) {
   HWY_DYNAMIC_DISPATCH(CostSimd)(left, right_rev, border, g, cost);
 }
-void Horizontal(const uint16_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                const uint16_t* p2_table, uint16_t p1, uint16_t* scratch, uint16_t* sum) {
+void Horizontal(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
   HWY_DYNAMIC_DISPATCH(HorizontalSimd)(cost, image_row, g, p2_table, p1, scratch, sum);
 }
-void Vertical(const uint16_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
-              const SgmRowGeometry& g, int paths, const uint16_t* p2_table, uint16_t p1,
-              uint16_t* const* prev, const uint16_t* const* prev_min, uint16_t* const* cur,
-              uint16_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+void Vertical(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
+              const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
+              uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
+              uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
   HWY_DYNAMIC_DISPATCH(VerticalSimd)(cost, image_row, prev_image_row, g, paths, p2_table, p1, prev,
                                      prev_min, cur, cur_min, src, dst);
 }

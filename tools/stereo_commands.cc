@@ -283,6 +283,8 @@ int RunBenchStereo(const CommandArgs& args) {
 
   auto sgm = SgmMatcher::Create(options);
   if (!sgm.ok()) return Fail(sgm.status());
+  const SgmMatcher* ours_sgm = sgm->get();
+  std::vector<SgmMatcher::StageTimes> stages;
   cv::setNumThreads(static_cast<int>(options.threads));
   const int min_d = static_cast<int>(options.min_disparity);
   const int num_d = static_cast<int>(options.num_disparities);
@@ -300,6 +302,7 @@ int RunBenchStereo(const CommandArgs& args) {
       const auto t1 = std::chrono::steady_clock::now();
       if (!s.ok()) return Fail(s);
       if (it > 0) times[m].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      if (it > 0 && m == 0) stages.push_back(ours_sgm->last_stage_times());
     }
   }
   const double ours = MedianMs(times[0]);
@@ -316,6 +319,20 @@ int RunBenchStereo(const CommandArgs& args) {
                 100.0 * valid / static_cast<double>(outputs[m].disparity.size()),
                 std::string(matchers[0]->name()).c_str(), med / ours);
   }
+  const auto stage_median = [&](double SgmMatcher::StageTimes::*field) {
+    std::vector<double> v;
+    for (const auto& st : stages) v.push_back(st.*field);
+    return MedianMs(v);
+  };
+  std::printf("  %s stages (median ms): census %.2f, first half %.2f, second half + WTA %.2f, "
+              "median %.2f, speckle %.2f, depth %.2f; buffers %.1f MB\n",
+              std::string(matchers[0]->name()).c_str(),
+              stage_median(&SgmMatcher::StageTimes::census_ms),
+              stage_median(&SgmMatcher::StageTimes::first_half_ms),
+              stage_median(&SgmMatcher::StageTimes::second_half_ms),
+              stage_median(&SgmMatcher::StageTimes::median_ms),
+              stage_median(&SgmMatcher::StageTimes::speckle_ms),
+              stage_median(&SgmMatcher::StageTimes::depth_ms), ours_sgm->buffer_bytes() / 1e6);
   return 0;
 }
 
