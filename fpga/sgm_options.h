@@ -16,8 +16,8 @@ struct SgmOptions {
   int64_t census_width = 9;
   int64_t census_height = 7;
   int64_t paths = 4;               // 4 (horizontal + vertical) or 8 (plus diagonals)
-  int64_t p1 = 7;                  // penalty for a disparity change of 1 px
-  int64_t p2 = 100;                // penalty for larger changes; census bits + 2 p2 <= 255
+  int64_t p1 = 10;                 // penalty for a disparity change of 1 px
+  int64_t p2 = 60;                 // penalty for larger changes; census bits + 2 p2 <= 255
   // P2 falls to p2 * s / (s + |dI|) across an intensity step dI (but not below p1 + 1): depth
   // edges usually coincide with intensity edges. 0 keeps P2 constant.
   int64_t p2_intensity_scale = 16;  // gray levels

@@ -128,6 +128,14 @@ bool ParseSgmOptions(const ArgMap& a, SgmOptions* o) {
   }
   o->backend = backend == "simd" ? SgmBackend::kSimd : SgmBackend::kScalar;
   if (a.Has("--fill")) o->fill_holes = true;
+  for (const auto& [key, field] : {std::pair<const char*, int64_t*>{"--p1", &o->p1},
+                                   {"--p2", &o->p2}, {"--uniqueness", &o->uniqueness_percent},
+                                   {"--speckle-size", &o->speckle_max_size}}) {
+    if (a.Get(key).empty()) continue;
+    long v = 0;
+    if (!ParseInt(a.Get(key), key, &v)) return false;
+    *field = v;
+  }
   const std::string census = a.Get("--census");
   if (!census.empty()) {
     int cw = 0, ch = 0;
@@ -157,10 +165,12 @@ int RunStereo(const CommandArgs& args) {
   const char* usage =
       "usage: cairn stereo LEFT RIGHT --max-disparity N [--min-disparity M] [--calib EUROC_DIR] "
       "[--paths 4|8] --out DISP.pfm [--png VIS.png] [--threads T] [--backend simd|scalar] "
-      "[--census WxH] [--fill]\n";
+      "[--census WxH] [--fill] [--matcher sgm|opencv-3way|opencv-hh4] [--p1 P] [--p2 P] "
+      "[--uniqueness PERCENT] [--speckle-size PIXELS]\n";
   const ArgMap a(args,
                  {"--max-disparity", "--min-disparity", "--calib", "--paths", "--out", "--png",
-                  "--threads", "--backend", "--census"},
+                  "--threads", "--backend", "--census", "--matcher", "--p1", "--p2", "--uniqueness",
+                  "--speckle-size"},
                  {"--fill"});
   if (!a.error.empty() || a.positional.size() != 2 || a.Get("--out").empty() ||
       a.Get("--max-disparity").empty()) {
@@ -191,10 +201,22 @@ int RunStereo(const CommandArgs& args) {
   input = InputOf(left, right);
   input.focal_px = focal;
   input.baseline_m = baseline;
-  auto matcher = SgmMatcher::Create(options);
-  if (!matcher.ok()) return Fail(matcher.status());
+  std::unique_ptr<StereoMatcher> matcher;
+  const std::string which = a.Get("--matcher", "sgm");
+  if (which == "sgm") {
+    auto sgm = SgmMatcher::Create(options);
+    if (!sgm.ok()) return Fail(sgm.status());
+    matcher = std::move(*sgm);
+  } else if (which == "opencv-3way" || which == "opencv-hh4") {
+    matcher = std::make_unique<OpenCvSgbmMatcher>(
+        static_cast<int>(options.min_disparity), static_cast<int>(options.num_disparities),
+        which == "opencv-3way" ? cv::StereoSGBM::MODE_SGBM_3WAY : cv::StereoSGBM::MODE_HH4);
+  } else {
+    std::fprintf(stderr, "cairn: --matcher must be sgm, opencv-3way or opencv-hh4\n");
+    return 2;
+  }
   StereoMatcherOutput out;
-  const Status s = (*matcher)->Match(input, &out);
+  const Status s = matcher->Match(input, &out);
   if (!s.ok()) return Fail(s);
   const Status w = WritePfm(a.Get("--out"), DisparityToFloat(out));
   if (!w.ok()) return Fail(w);
@@ -247,7 +269,8 @@ int RunStereoEval(const CommandArgs& args) {
 int RunBenchStereo(const CommandArgs& args) {
   const ArgMap a(args,
                  {"--left", "--right", "--size", "--max-disparity", "--min-disparity", "--paths",
-                  "--threads", "--iterations", "--backend", "--census"},
+                  "--threads", "--iterations", "--backend", "--census", "--p1", "--p2",
+                  "--uniqueness", "--speckle-size"},
                  {});
   if (!a.error.empty() || !a.positional.empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
