@@ -44,26 +44,47 @@ void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int 
     }
     const int16_t* u = c - width;
     const int16_t* d = c + width;
-    // Interior: a branch-free median-of-9 network (vectorized by the compiler), then the pixels
-    // with an invalid neighbour are redone with the general rule. kInvalidDisparity is the
-    // smallest int16, so a window holding one sorts it first and is detected by the minimum.
+    // Interior: a branch-free odd-even transposition sort of the 9 values (9 rounds sort 9
+    // inputs), vectorized by the compiler. kInvalidDisparity is the smallest int16, so the
+    // invalid values come first and the median of the n valid ones sits at 9 - n + (n - 1) / 2.
     for (int x = 1; x < width - 1; ++x) {
       int16_t p0 = u[x - 1], p1 = u[x], p2 = u[x + 1], p3 = c[x - 1], p4 = c[x], p5 = c[x + 1],
               p6 = d[x - 1], p7 = d[x], p8 = d[x + 1];
-      const int16_t lowest = std::min({p0, p1, p2, p3, p4, p5, p6, p7, p8});
-      Sort2(p1, p2); Sort2(p4, p5); Sort2(p7, p8); Sort2(p0, p1); Sort2(p3, p4); Sort2(p6, p7);
-      Sort2(p1, p2); Sort2(p4, p5); Sort2(p7, p8); Sort2(p0, p3); Sort2(p5, p8); Sort2(p4, p7);
-      Sort2(p3, p6); Sort2(p1, p4); Sort2(p2, p5); Sort2(p4, p7); Sort2(p4, p2); Sort2(p6, p4);
-      Sort2(p4, p2);
-      o[x] = lowest == kInvalidDisparity ? kInvalidDisparity : p4;
+      const int16_t centre = p4;
+      Sort2(p0, p1); Sort2(p2, p3); Sort2(p4, p5); Sort2(p6, p7);
+      Sort2(p1, p2); Sort2(p3, p4); Sort2(p5, p6); Sort2(p7, p8);
+      Sort2(p0, p1); Sort2(p2, p3); Sort2(p4, p5); Sort2(p6, p7);
+      Sort2(p1, p2); Sort2(p3, p4); Sort2(p5, p6); Sort2(p7, p8);
+      Sort2(p0, p1); Sort2(p2, p3); Sort2(p4, p5); Sort2(p6, p7);
+      Sort2(p1, p2); Sort2(p3, p4); Sort2(p5, p6); Sort2(p7, p8);
+      Sort2(p0, p1); Sort2(p2, p3); Sort2(p4, p5); Sort2(p6, p7);
+      Sort2(p1, p2); Sort2(p3, p4); Sort2(p5, p6); Sort2(p7, p8);
+      Sort2(p0, p1); Sort2(p2, p3); Sort2(p4, p5); Sort2(p6, p7);
+      const int invalid = (p0 == kInvalidDisparity) + (p1 == kInvalidDisparity) +
+                          (p2 == kInvalidDisparity) + (p3 == kInvalidDisparity) +
+                          (p4 == kInvalidDisparity) + (p5 == kInvalidDisparity) +
+                          (p6 == kInvalidDisparity) + (p7 == kInvalidDisparity) +
+                          (p8 == kInvalidDisparity);
+      const int at = invalid + (8 - invalid) / 2;
+      // Selections as bit masks keep the loop free of branches.
+      const auto pick = [at](int j, int16_t v, int16_t m) {
+        const int16_t mask = static_cast<int16_t>(-static_cast<int16_t>(at == j));
+        return static_cast<int16_t>((v & mask) | (m & ~mask));
+      };
+      int16_t m = p0;
+      m = pick(1, p1, m);
+      m = pick(2, p2, m);
+      m = pick(3, p3, m);
+      m = pick(4, p4, m);
+      m = pick(5, p5, m);
+      m = pick(6, p6, m);
+      m = pick(7, p7, m);
+      m = pick(8, p8, m);
+      const int16_t keep = static_cast<int16_t>(-static_cast<int16_t>(centre != kInvalidDisparity));
+      o[x] = static_cast<int16_t>((m & keep) | (kInvalidDisparity & ~keep));
     }
     for (int x : {0, width - 1}) {
       o[x] = c[x] == kInvalidDisparity ? kInvalidDisparity : MedianOfValid(in, width, height, x, y);
-    }
-    for (int x = 1; x < width - 1; ++x) {
-      if (o[x] == kInvalidDisparity && c[x] != kInvalidDisparity) {
-        o[x] = MedianOfValid(in, width, height, x, y);
-      }
     }
   }
 }
