@@ -1,6 +1,7 @@
 #include "fpga/disparity_evaluator.h"
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
 #include <opencv2/imgcodecs.hpp>
@@ -29,6 +30,7 @@ const char* DisparityMetricName(DisparityMetric metric) {
 
 Expected<FloatImage> LoadGroundTruth(const std::string& path, double scale) {
   if (path.size() > 4 && path.substr(path.size() - 4) == ".pfm") return ReadPfm(path);
+  if (!std::filesystem::is_regular_file(path)) return NotFoundError("no such ground truth file " + path);
   const cv::Mat m = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
   if (m.empty()) return NotFoundError("cannot read ground truth image " + path);
   if (m.depth() != CV_8U && m.depth() != CV_16U) {
@@ -48,8 +50,9 @@ Expected<FloatImage> LoadGroundTruth(const std::string& path, double scale) {
 }
 
 Expected<FloatImage> LoadMask(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) return NotFoundError("no such mask file " + path);
   const cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (m.empty()) return NotFoundError("cannot read mask image " + path);
+  if (m.empty()) return DataLossError("cannot decode mask image " + path);
   FloatImage img{m.cols, m.rows, {}};
   img.data.resize(static_cast<size_t>(m.cols) * m.rows);
   for (int y = 0; y < m.rows; ++y) {

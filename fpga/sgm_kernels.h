@@ -33,9 +33,11 @@ struct SgmKernels {
   // in the most significant used bit.
   void (*census)(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch,
                  uint32_t* out);
-  // cost[x*D + k] = max(popcount(left[x] ^ right_rev[i]), border[i]), i = rev_base - x + k.
-  void (*cost)(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-               const SgmRowGeometry& g, uint8_t* cost);
+  // cost[x*D + k] = max(popcount(left[x] ^ right(i)), border[i]), i = rev_base - x + k, where
+  // right(i) is the reversed right census stored as `planes` byte planes: byte b of right(i) is
+  // right_planes[b * plane_stride + i] (planes = ceil(census bits / 8); the other bytes are 0).
+  void (*cost)(const uint32_t* left, const uint8_t* right_planes, int plane_stride, int planes,
+               const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost);
   // The left-to-right and right-to-left paths; sum = their sum. scratch: 4 path blocks.
   void (*horizontal)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum);

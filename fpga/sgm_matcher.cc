@@ -84,8 +84,8 @@ void SgmMatcher::Allocate(int width, int height) {
         s.path_min[b][p] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
       }
     }
-    s.right_rev = AllocateBuffer<uint32_t>(n_rev, &buffer_bytes_);
-    s.border = AllocateBuffer<uint32_t>(n_rev, &buffer_bytes_);
+    s.right_planes = AllocateBuffer<uint8_t>(4 * n_rev, &buffer_bytes_);
+    s.border = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
     s.best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
     s.right_best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
   }
@@ -107,16 +107,20 @@ void SgmMatcher::PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, 
 void SgmMatcher::ComputeCost(Sweep& s, int y) {
   const SgmRowGeometry& g = geometry_;
   const int n_rev = g.rev_base + g.disparities;
+  const int plane_stride = n_rev + 64;  // as allocated: 4 planes of n_rev + 64 bytes
+  const int planes = (options_.census_bits() + 7) / 8;
   const int pad = g.rev_base - (width_ - 1) - g.min_disparity;  // = max(0, -d_min)
   const uint32_t* cr = census_right_.get() + static_cast<size_t>(y) * width_;
-  const uint32_t border_cost = static_cast<uint32_t>(options_.census_bits());
+  const uint8_t border_cost = static_cast<uint8_t>(options_.census_bits());
+  uint8_t* rp = s.right_planes.get();
   for (int i = 0; i < n_rev; ++i) {
     const int xr = width_ - 1 + pad - i;
     const bool inside = xr >= 0 && xr < width_;
-    s.right_rev[i] = inside ? cr[xr] : 0u;
-    s.border[i] = inside ? 0u : border_cost;
+    const uint32_t c = inside ? cr[xr] : 0u;
+    for (int b = 0; b < planes; ++b) rp[b * plane_stride + i] = static_cast<uint8_t>(c >> (8 * b));
+    s.border[i] = inside ? 0 : border_cost;
   }
-  kernels_->cost(census_left_.get() + static_cast<size_t>(y) * width_, s.right_rev.get(),
+  kernels_->cost(census_left_.get() + static_cast<size_t>(y) * width_, rp, plane_stride, planes,
                  s.border.get(), g, s.cost.get());
 }
 

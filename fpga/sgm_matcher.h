@@ -51,7 +51,7 @@ class SgmMatcher final : public StereoMatcher {
     Buffer<uint16_t> row_sum, wta_scratch;
     Buffer<uint8_t> path[2][3];  // [prev/cur][path]
     Buffer<uint8_t> path_min[2][3];
-    Buffer<uint32_t> right_rev, border;
+    Buffer<uint8_t> right_planes, border;  // reversed right census row (sgm_kernels.h)
     Buffer<int16_t> best, right_best;
     int cur = 0;          // which of path[0], path[1] receives the next row
     bool has_prev = false;

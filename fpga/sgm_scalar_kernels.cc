@@ -26,14 +26,18 @@ void CensusScalar(const uint8_t* center, ptrdiff_t stride, int width, int cw, in
   }
 }
 
-void CostScalar(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-                const SgmRowGeometry& g, uint8_t* cost) {
+void CostScalar(const uint32_t* left, const uint8_t* right_planes, int plane_stride, int planes,
+                const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost) {
   const int d_count = g.disparities;
   for (int x = 0; x < g.width; ++x) {
     const int base = g.rev_base - x;
     for (int k = 0; k < d_count; ++k) {
-      const uint32_t c = static_cast<uint32_t>(std::popcount(left[x] ^ right_rev[base + k]));
-      cost[x * d_count + k] = static_cast<uint8_t>(std::max(c, border[base + k]));
+      uint32_t right = 0;
+      for (int b = 0; b < planes; ++b) {
+        right |= uint32_t{right_planes[b * plane_stride + base + k]} << (8 * b);
+      }
+      const int c = std::popcount(left[x] ^ right);
+      cost[x * d_count + k] = static_cast<uint8_t>(std::max<int>(c, border[base + k]));
     }
   }
 }

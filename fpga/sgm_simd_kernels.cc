@@ -56,22 +56,35 @@ static void CensusSimd(const uint8_t* center, ptrdiff_t stride, int width, int c
   }
 }
 
-static void CostSimd(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-                     const SgmRowGeometry& g, uint8_t* cost) {
-  const D32 du;
-  const DI32 di;
-  const hn::Rebind<uint8_t, DI32> d8;
-  const int n = static_cast<int>(hn::Lanes(du));
+// Hamming distances byte plane by byte plane: 8-bit popcounts need no widening.
+template <class D8>
+void CostImpl(D8 d, const uint32_t* left, const uint8_t* right_planes, int plane_stride,
+              int planes, const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost) {
+  const int n = static_cast<int>(hn::Lanes(d));
   const int d_count = g.disparities;
   for (int x = 0; x < g.width; ++x) {
-    const auto vl = hn::Set(du, left[x]);
     const int base = g.rev_base - x;
     uint8_t* out = cost + x * d_count;
     for (int k = 0; k < d_count; k += n) {
-      const auto pc = hn::PopulationCount(hn::Xor(vl, hn::LoadU(du, right_rev + base + k)));
-      const auto c = hn::Max(pc, hn::LoadU(du, border + base + k));
-      hn::StoreU(hn::DemoteTo(d8, hn::BitCast(di, c)), d8, out + k);
+      auto acc = hn::Zero(d);
+      for (int b = 0; b < planes; ++b) {
+        const auto lb = hn::Set(d, static_cast<uint8_t>(left[x] >> (8 * b)));
+        const auto v = hn::Xor(hn::LoadU(d, right_planes + b * plane_stride + base + k), lb);
+        acc = hn::Add(acc, hn::PopulationCount(v));
+      }
+      hn::StoreU(hn::Max(acc, hn::LoadU(d, border + base + k)), d, out + k);
     }
+  }
+}
+
+static void CostSimd(const uint32_t* left, const uint8_t* right_planes, int plane_stride,
+                     int planes, const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost) {
+  const hn::ScalableTag<uint8_t> full;
+  if (g.disparities % static_cast<int>(hn::Lanes(full)) == 0) {
+    CostImpl(full, left, right_planes, plane_stride, planes, border, g, cost);
+  } else {
+    CostImpl(hn::CappedTag<uint8_t, 16>(), left, right_planes, plane_stride, planes, border, g,
+             cost);
   }
 }
 
@@ -282,9 +295,9 @@ HWY_EXPORT(TargetSimd);
 void Census(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch, uint32_t* out) {
   HWY_DYNAMIC_DISPATCH(CensusSimd)(center, stride, width, cw, ch, out);
 }
-void Cost(const uint32_t* left, const uint32_t* right_rev, const uint32_t* border,
-          const SgmRowGeometry& g, uint8_t* cost) {
-  HWY_DYNAMIC_DISPATCH(CostSimd)(left, right_rev, border, g, cost);
+void Cost(const uint32_t* left, const uint8_t* right_planes, int plane_stride, int planes,
+          const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost) {
+  HWY_DYNAMIC_DISPATCH(CostSimd)(left, right_planes, plane_stride, planes, border, g, cost);
 }
 void Horizontal(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
                 const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {

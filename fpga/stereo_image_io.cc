@@ -1,6 +1,7 @@
 #include "fpga/stereo_image_io.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <limits>
 
 #include <opencv2/imgcodecs.hpp>
@@ -10,6 +11,10 @@ namespace cairn {
 
 Expected<GrayPair> LoadGrayPair(const std::string& left_path, const std::string& right_path) {
   GrayPair pair;
+  // Checked first so that a missing file gives our message, not only OpenCV's warning.
+  for (const std::string& p : {left_path, right_path}) {
+    if (!std::filesystem::is_regular_file(p)) return NotFoundError("no such image file " + p);
+  }
   pair.left = cv::imread(left_path, cv::IMREAD_GRAYSCALE);
   if (pair.left.empty()) return NotFoundError("cannot read left image " + left_path);
   pair.right = cv::imread(right_path, cv::IMREAD_GRAYSCALE);
