@@ -94,31 +94,40 @@ void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, 
   if (max_size <= 0) return;
   const size_t n = static_cast<size_t>(width) * height;
   label_.assign(n, 0);  // no reallocation once the size was seen
-  stack_.resize(n);
+  stack_.resize(2 * n);  // (x, y) pairs: no division per visited pixel
   region_.resize(n);
-  for (size_t start = 0; start < n; ++start) {
-    if (label_[start] != 0 || disparity[start] == kInvalidDisparity) continue;
-    // Flood fill, remembering the members so that a small region can be cleared afterwards.
-    int top = 0, count = 0;
-    stack_[top++] = static_cast<int32_t>(start);
-    label_[start] = 1;
-    while (top > 0) {
-      const int32_t p = stack_[--top];
-      region_[count++] = p;
-      const int px = p % width, py = p / width;
-      const int16_t dp = disparity[p];
-      const int32_t nb[4] = {px > 0 ? p - 1 : -1, px + 1 < width ? p + 1 : -1,
-                             py > 0 ? p - width : -1, py + 1 < height ? p + width : -1};
-      for (int32_t q : nb) {
-        if (q < 0 || label_[q] != 0) continue;
-        const int16_t dq = disparity[q];
-        if (dq == kInvalidDisparity || std::abs(dq - dp) > max_diff) continue;
-        label_[q] = 1;
-        stack_[top++] = q;
+  for (int sy = 0; sy < height; ++sy) {
+    for (int sx = 0; sx < width; ++sx) {
+      const size_t start = static_cast<size_t>(sy) * width + sx;
+      if (label_[start] != 0 || disparity[start] == kInvalidDisparity) continue;
+      // Flood fill, remembering the members so that a small region can be cleared afterwards.
+      int top = 0, count = 0;
+      stack_[top++] = sx;
+      stack_[top++] = sy;
+      label_[start] = 1;
+      while (top > 0) {
+        const int py = stack_[--top];
+        const int px = stack_[--top];
+        const int32_t p = py * width + px;
+        region_[count++] = p;
+        const int16_t dp = disparity[p];
+        const auto visit = [&](int qx, int qy) {
+          const int32_t q = qy * width + qx;
+          if (label_[q] != 0) return;
+          const int16_t dq = disparity[q];
+          if (dq == kInvalidDisparity || std::abs(dq - dp) > max_diff) return;
+          label_[q] = 1;
+          stack_[top++] = qx;
+          stack_[top++] = qy;
+        };
+        if (px > 0) visit(px - 1, py);
+        if (px + 1 < width) visit(px + 1, py);
+        if (py > 0) visit(px, py - 1);
+        if (py + 1 < height) visit(px, py + 1);
       }
-    }
-    if (count < max_size) {
-      for (int i = 0; i < count; ++i) disparity[region_[i]] = kInvalidDisparity;
+      if (count < max_size) {
+        for (int i = 0; i < count; ++i) disparity[region_[i]] = kInvalidDisparity;
+      }
     }
   }
 }

@@ -22,7 +22,7 @@ class DisparityFilter {
   static void FillHolesRow(int16_t* row, int width);
 
  private:
-  std::vector<int32_t> label_;
+  std::vector<uint8_t> label_;
   std::vector<int32_t> stack_;
   std::vector<int32_t> region_;
 };
