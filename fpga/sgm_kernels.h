@@ -43,10 +43,11 @@ struct SgmKernels {
                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum);
   // `paths` (1 or 3) paths arriving from the previous row at x, x-1, x+1. prev == nullptr on the
   // first row of a sweep. dst[x*D + k] = src[...] + sum of the new path costs (dst may be src).
+  // stream_dst hints that dst is not read again soon (a backend may bypass the cache).
   void (*vertical)(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
                    const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
                    uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
-                   uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst);
+                   uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst, bool stream_dst);
   // Winner-take-all of one sum row. best[x] = argmin_k (smallest k on ties), or -1 - best when
   // the uniqueness test fails. right_best[xr] = argmin_k sum(xr + d_min + k, k) over the row, -1
   // where no candidate exists. scratch: 2 * (rev_base + D + 1) uint16.

@@ -130,9 +130,12 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
   const int paths = options_.paths == 8 ? 3 : 1;
   ComputeCost(s, y);
   uint16_t* sum_row = sum_.get() + static_cast<size_t>(y) * width_ * g.disparities;
+  // First visit: the horizontal paths go to the row buffer, and the volume row is written once
+  // (streamed past the cache: the other sweep reads it much later). Second visit: the volume row
+  // plus this sweep's paths land in the row buffer for winner-take-all.
   if (!finish) {
     kernels_->horizontal(s.cost.get(), image_row(y), g, p2_table_, p1,
-                         s.horizontal_scratch.get(), sum_row);
+                         s.horizontal_scratch.get(), s.row_sum.get());
   }
   const int prev = 1 - s.cur;
   uint8_t* prev_paths[3];
@@ -145,10 +148,10 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
     cur_paths[p] = s.path[s.cur][p].get();
     cur_min[p] = s.path_min[s.cur][p].get();
   }
-  uint16_t* dst = finish ? s.row_sum.get() : sum_row;
   kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr, g,
                      paths, p2_table_, p1, s.has_prev ? prev_paths : nullptr, prev_min,
-                     cur_paths, cur_min, sum_row, dst);
+                     cur_paths, cur_min, finish ? sum_row : s.row_sum.get(),
+                     finish ? s.row_sum.get() : sum_row, /*stream_dst=*/!finish);
   s.cur = prev;
   s.has_prev = true;
   s.prev_y = y;

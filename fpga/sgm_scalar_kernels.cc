@@ -84,7 +84,8 @@ void HorizontalScalar(const uint8_t* cost, const uint8_t* image_row, const SgmRo
 void VerticalScalar(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
                     const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
                     uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
-                    uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+                    uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst,
+                    bool /*stream_dst*/) {
   const int d_count = g.disparities;
   static constexpr int kOffsets[3] = {0, -1, 1};
   // A path entering the image starts from zero costs, which makes its first step return C.

@@ -12,6 +12,7 @@
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "fpga/sgm_simd_kernels.cc"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/cache_control.h"
 #include "hwy/highway.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -90,7 +91,7 @@ static void CostSimd(const uint32_t* left, const uint8_t* right_planes, int plan
 
 // One SGM recursion step (see Step in sgm_scalar_kernels.cc), on 8-bit lanes; also
 // dst[k] = (kAddSrc ? src[k] : 0) + out[k] in 16 bits.
-template <bool kAddSrc, class D8>
+template <bool kAddSrc, class D8, bool kStream = false>
 HWY_INLINE uint8_t StepSimd(D8 d, const uint8_t* c, const uint8_t* prev, uint8_t min_prev,
                             uint8_t p1, uint8_t p2, int d_count, uint8_t* out,
                             const uint16_t* src, uint16_t* dst) {
@@ -123,8 +124,13 @@ HWY_INLINE uint8_t StepSimd(D8 d, const uint8_t* c, const uint8_t* prev, uint8_t
       lo = hn::Add(lo, hn::LoadU(dw, src + k));
       hi = hn::Add(hi, hn::LoadU(dw, src + k + nh));
     }
-    hn::StoreU(lo, dw, dst + k);
-    hn::StoreU(hi, dw, dst + k + nh);
+    if constexpr (kStream) {  // dst is aligned to whole vectors here (see VerticalSimd)
+      hn::Stream(lo, dw, dst + k);
+      hn::Stream(hi, dw, dst + k + nh);
+    } else {
+      hn::StoreU(lo, dw, dst + k);
+      hn::StoreU(hi, dw, dst + k + nh);
+    }
   }
   const auto bw = hn::Min(hn::PromoteTo(dw, hn::LowerHalf(dh, best)),
                           hn::PromoteTo(dw, hn::UpperHalf(dh, best)));
@@ -162,7 +168,7 @@ void HorizontalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row, const S
   }
 }
 
-template <class D8>
+template <bool kStream, class D8>
 void VerticalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
                   const uint8_t* prev_image_row, const SgmRowGeometry& g, int paths,
                   const uint8_t* p2_table, uint8_t p1, uint8_t* const* prev,
@@ -171,6 +177,7 @@ void VerticalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
   const int d_count = g.disparities;
   static constexpr int kOffsets[3] = {0, -1, 1};
   HWY_ALIGN uint8_t zero_block[512 + 2 * kPathPad];
+  HWY_ALIGN uint16_t partial[512];  // sums of the earlier paths of one pixel
   std::fill(zero_block, zero_block + g.block, uint8_t{0});
   zero_block[kPathPad - 1] = kPathSentinel;
   zero_block[kPathPad + d_count] = kPathSentinel;
@@ -184,11 +191,17 @@ void VerticalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
       const uint8_t p2 =
           inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
       uint8_t* out = cur[p] + x * g.block + kPathPad;
-      const uint16_t* s = p == 0 ? src + x * d_count : dst + x * d_count;
-      cur_min[p][x] = StepSimd<true>(d, cost + x * d_count, lp, mp, p1, p2, d_count, out, s,
-                                     dst + x * d_count);
+      const uint16_t* s = p == 0 ? src + x * d_count : partial;
+      const uint8_t* c = cost + x * d_count;
+      if (p + 1 < paths) {
+        cur_min[p][x] = StepSimd<true>(d, c, lp, mp, p1, p2, d_count, out, s, partial);
+      } else {
+        cur_min[p][x] =
+            StepSimd<true, D8, kStream>(d, c, lp, mp, p1, p2, d_count, out, s, dst + x * d_count);
+      }
     }
   }
+  if constexpr (kStream) hwy::FlushStream();
 }
 
 // Full vectors when the disparity count is a multiple of their length, else 16 lanes.
@@ -206,14 +219,23 @@ static void VerticalSimd(const uint8_t* cost, const uint8_t* image_row,
                          const uint8_t* prev_image_row, const SgmRowGeometry& g, int paths,
                          const uint8_t* p2_table, uint8_t p1, uint8_t* const* prev,
                          const uint8_t* const* prev_min, uint8_t* const* cur,
-                         uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+                         uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst,
+                         bool stream_dst) {
   const hn::ScalableTag<uint8_t> full;
+  const size_t vector_bytes = hn::Lanes(full);  // = bytes of one half-width uint16 vector
+  // Streaming stores need whole-vector alignment: every pixel's sums then start aligned.
+  const bool aligned = reinterpret_cast<uintptr_t>(dst) % vector_bytes == 0;
   if (g.disparities % static_cast<int>(hn::Lanes(full)) == 0) {
-    VerticalImpl(full, cost, image_row, prev_image_row, g, paths, p2_table, p1, prev, prev_min,
-                 cur, cur_min, src, dst);
+    if (stream_dst && aligned && src != dst) {
+      VerticalImpl<true>(full, cost, image_row, prev_image_row, g, paths, p2_table, p1, prev,
+                         prev_min, cur, cur_min, src, dst);
+    } else {
+      VerticalImpl<false>(full, cost, image_row, prev_image_row, g, paths, p2_table, p1, prev,
+                          prev_min, cur, cur_min, src, dst);
+    }
   } else {
-    VerticalImpl(hn::CappedTag<uint8_t, 16>(), cost, image_row, prev_image_row, g, paths, p2_table,
-                 p1, prev, prev_min, cur, cur_min, src, dst);
+    VerticalImpl<false>(hn::CappedTag<uint8_t, 16>(), cost, image_row, prev_image_row, g, paths,
+                        p2_table, p1, prev, prev_min, cur, cur_min, src, dst);
   }
 }
 
@@ -306,9 +328,9 @@ void Horizontal(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeome
 void Vertical(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
               const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
               uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
-              uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst) {
+              uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst, bool stream_dst) {
   HWY_DYNAMIC_DISPATCH(VerticalSimd)(cost, image_row, prev_image_row, g, paths, p2_table, p1, prev,
-                                     prev_min, cur, cur_min, src, dst);
+                                     prev_min, cur, cur_min, src, dst, stream_dst);
 }
 void Wta(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent, uint16_t* scratch,
          int16_t* best, int16_t* right_best) {
