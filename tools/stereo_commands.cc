@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <time.h>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -152,6 +154,14 @@ bool ParseSgmOptions(const ArgMap& a, SgmOptions* o) {
     return false;
   }
   return true;
+}
+
+// CPU time of the whole process (all threads): unlike wall time it barely depends on what else
+// runs on the machine, so it still compares the matchers when the cores are shared.
+double ProcessCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 
 double MedianMs(std::vector<double> v) {
@@ -315,32 +325,39 @@ int RunBenchStereo(const CommandArgs& args) {
   matchers.push_back(std::move(*sgm));
   matchers.push_back(std::make_unique<OpenCvSgbmMatcher>(min_d, num_d, cv::StereoSGBM::MODE_SGBM_3WAY));
   matchers.push_back(std::make_unique<OpenCvSgbmMatcher>(min_d, num_d, cv::StereoSGBM::MODE_HH4));
-  std::vector<std::vector<double>> times(matchers.size());
+  std::vector<std::vector<double>> times(matchers.size()), cpu_times(matchers.size());
   std::vector<StereoMatcherOutput> outputs(matchers.size());
   // Interleaved rounds so that all matchers see the same machine state; one warm-up round.
   for (long it = 0; it <= iterations; ++it) {
     for (size_t m = 0; m < matchers.size(); ++m) {
+      const double c0 = ProcessCpuMs();
       const auto t0 = std::chrono::steady_clock::now();
       const Status s = matchers[m]->Match(input, &outputs[m]);
       const auto t1 = std::chrono::steady_clock::now();
+      const double c1 = ProcessCpuMs();
       if (!s.ok()) return Fail(s);
       if (it > 0) times[m].push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      if (it > 0) cpu_times[m].push_back(c1 - c0);
       if (it > 0 && m == 0) stages.push_back(ours_sgm->last_stage_times());
     }
   }
   const double ours = MedianMs(times[0]);
+  const double ours_cpu = MedianMs(cpu_times[0]);
   std::printf("bench stereo: %dx%d, disparities [%d, %d), %ld paths, %ld threads, %ld iterations, "
               "SIMD target %s\n",
               width, height, min_d, min_d + num_d, static_cast<long>(options.paths),
               static_cast<long>(options.threads), iterations, SimdTargetName());
+  std::printf("  (ratio = that matcher's median / %s's median: above 1 means %s is faster)\n",
+              std::string(matchers[0]->name()).c_str(), std::string(matchers[0]->name()).c_str());
   for (size_t m = 0; m < matchers.size(); ++m) {
     const double med = MedianMs(times[m]);
+    const double cpu = MedianMs(cpu_times[m]);
     long valid = 0;
     for (int16_t d : outputs[m].disparity) valid += d != kInvalidDisparity;
-    std::printf("  %-18s median %8.2f ms  %6.2f Hz  density %5.1f %%  ratio to %s %.2fx\n",
-                std::string(matchers[m]->name()).c_str(), med, 1000.0 / med,
-                100.0 * valid / static_cast<double>(outputs[m].disparity.size()),
-                std::string(matchers[0]->name()).c_str(), med / ours);
+    std::printf("  %-18s wall median %8.2f ms (%6.2f Hz, ratio %.2f)  cpu median %8.2f ms "
+                "(ratio %.2f)  density %5.1f %%\n",
+                std::string(matchers[m]->name()).c_str(), med, 1000.0 / med, med / ours, cpu,
+                cpu / ours_cpu, 100.0 * valid / static_cast<double>(outputs[m].disparity.size()));
   }
   const auto stage_median = [&](double SgmMatcher::StageTimes::*field) {
     std::vector<double> v;
