@@ -16,7 +16,7 @@
 namespace cairn {
 
 inline constexpr uint8_t kPathSentinel = 0xFF;
-inline constexpr int kPathPad = 64;  // lanes before and after each path block (keeps alignment)
+inline constexpr int kPathPad = 16;  // lanes before and after each path block
 
 struct SgmRowGeometry {
   int width = 0;
