@@ -4,9 +4,10 @@
 // the Highway set must give the same result for every input (all arithmetic is integer).
 //
 // Layouts: a cost row is width * D uint8 and a sum row width * D uint16 (disparity index k
-// fastest, k = d - d_min). A path row holds one block of `block` uint8 per pixel whose lanes
-// [0, D) are the path costs and whose lanes -1 and D hold kPathSentinel, so the +-1 neighbours
-// read there never win. Path costs fit 8 bits because SgmOptions::Validate demands
+// fastest, k = d - d_min). A path row is kPathLead sentinel bytes followed by one block of
+// `block` = D + kPathTail uint8 per pixel: lanes [0, D) are the path costs, the rest hold
+// kPathSentinel, so lane D and lane -1 (the previous block's tail, or the lead) never win as
+// +-1 neighbours. Pointers to path rows point at the first block. Path costs fit 8 bits because SgmOptions::Validate demands
 // census_bits + 2 * p2 <= 255: a path cost is at most C + P2 and the jump term min + P2 at most
 // census_bits + 2 * P2, so no addition overflows and none saturates.
 
@@ -16,12 +17,13 @@
 namespace cairn {
 
 inline constexpr uint8_t kPathSentinel = 0xFF;
-inline constexpr int kPathPad = 16;  // lanes before and after each path block
+inline constexpr int kPathLead = 64;
+inline constexpr int kPathTail = 16;  // small blocks: the path rows are the working set
 
 struct SgmRowGeometry {
   int width = 0;
   int disparities = 0;  // D, a multiple of 16
-  int block = 0;        // D + 2 * kPathPad
+  int block = 0;        // D + kPathTail
   int min_disparity = 0;
   // Reversed right-census index of (x, k): rev_base - x + k (see SgmKernels::cost).
   int rev_base = 0;
@@ -38,7 +40,7 @@ struct SgmKernels {
   // right_planes[b * plane_stride + i] (planes = ceil(census bits / 8); the other bytes are 0).
   void (*cost)(const uint32_t* left, const uint8_t* right_planes, int plane_stride, int planes,
                const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost);
-  // The left-to-right and right-to-left paths; sum = their sum. scratch: 4 path blocks.
+  // The left-to-right and right-to-left paths; sum = their sum. scratch: a path row of 4 blocks.
   void (*horizontal)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum);
   // `paths` (1 or 3) paths arriving from the previous row at x, x-1, x+1. prev == nullptr on the

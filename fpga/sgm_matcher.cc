@@ -53,7 +53,7 @@ void SgmMatcher::Allocate(int width, int height) {
   const int dmin = static_cast<int>(options_.min_disparity);
   geometry_.width = width;
   geometry_.disparities = d;
-  geometry_.block = d + 2 * kPathPad;
+  geometry_.block = d + kPathTail;
   geometry_.min_disparity = dmin;
   geometry_.rev_base = width - 1 + dmin + std::max(0, -dmin);
   const size_t w = static_cast<size_t>(width), h = static_cast<size_t>(height);
@@ -73,14 +73,14 @@ void SgmMatcher::Allocate(int width, int height) {
   for (Sweep& s : sweeps_) {
     s.cost = AllocateBuffer<uint8_t>(w * d, &buffer_bytes_);
     s.row_sum = AllocateBuffer<uint16_t>(w * d, &buffer_bytes_);
-    s.horizontal_scratch = AllocateBuffer<uint8_t>(4 * geometry_.block, &buffer_bytes_);
+    s.horizontal_scratch = AllocateBuffer<uint8_t>(kPathLead + 4 * geometry_.block, &buffer_bytes_);
     s.wta_scratch = AllocateBuffer<uint16_t>(2 * n_rev, &buffer_bytes_);
-    std::fill_n(s.horizontal_scratch.get(), 4 * geometry_.block, kPathSentinel);
+    std::fill_n(s.horizontal_scratch.get(), kPathLead + 4 * geometry_.block, kPathSentinel);
     for (int b = 0; b < 2; ++b) {
       for (int p = 0; p < 3; ++p) {
         // Sentinels fill the block pads once; the kernels only ever write lanes [0, D).
-        s.path[b][p] = AllocateBuffer<uint8_t>(w * geometry_.block, &buffer_bytes_);
-        std::fill_n(s.path[b][p].get(), w * geometry_.block, kPathSentinel);
+        s.path[b][p] = AllocateBuffer<uint8_t>(kPathLead + w * geometry_.block, &buffer_bytes_);
+        std::fill_n(s.path[b][p].get(), kPathLead + w * geometry_.block, kPathSentinel);
         s.path_min[b][p] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
       }
     }
@@ -135,7 +135,7 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
   // plus this sweep's paths land in the row buffer for winner-take-all.
   if (!finish) {
     kernels_->horizontal(s.cost.get(), image_row(y), g, p2_table_, p1,
-                         s.horizontal_scratch.get(), s.row_sum.get());
+                         s.horizontal_scratch.get() + kPathLead, s.row_sum.get());
   }
   const int prev = 1 - s.cur;
   uint8_t* prev_paths[3];
@@ -143,9 +143,9 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
   uint8_t* cur_paths[3];
   uint8_t* cur_min[3];
   for (int p = 0; p < 3; ++p) {
-    prev_paths[p] = s.path[prev][p].get();
+    prev_paths[p] = s.path[prev][p].get() + kPathLead;
     prev_min[p] = s.path_min[prev][p].get();
-    cur_paths[p] = s.path[s.cur][p].get();
+    cur_paths[p] = s.path[s.cur][p].get() + kPathLead;
     cur_min[p] = s.path_min[s.cur][p].get();
   }
   kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr, g,

@@ -63,8 +63,8 @@ uint8_t Step(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uint8_t p1
 void HorizontalScalar(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
                       const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
   const int d_count = g.disparities;
-  uint8_t* a = scratch + kPathPad;
-  uint8_t* b = scratch + g.block + kPathPad;
+  uint8_t* a = scratch;
+  uint8_t* b = scratch + g.block;
   for (int pass = 0; pass < 2; ++pass) {
     std::fill(a, a + d_count, uint8_t{0});
     uint8_t min_prev = 0;
@@ -89,20 +89,19 @@ void VerticalScalar(const uint8_t* cost, const uint8_t* image_row, const uint8_t
   const int d_count = g.disparities;
   static constexpr int kOffsets[3] = {0, -1, 1};
   // A path entering the image starts from zero costs, which makes its first step return C.
-  uint8_t zero_block[512 + 2 * kPathPad];
-  std::fill(zero_block, zero_block + g.block, uint8_t{0});
-  zero_block[kPathPad - 1] = kPathSentinel;
-  zero_block[kPathPad + d_count] = kPathSentinel;
-  const uint8_t* zero = zero_block + kPathPad;
+  uint8_t zero_block[kPathLead + 512 + kPathTail];
+  std::fill(zero_block, zero_block + kPathLead + g.block, kPathSentinel);
+  std::fill(zero_block + kPathLead, zero_block + kPathLead + d_count, uint8_t{0});
+  const uint8_t* zero = zero_block + kPathLead;
   for (int x = 0; x < g.width; ++x) {
     for (int k = 0; k < d_count; ++k) dst[x * d_count + k] = src[x * d_count + k];
     for (int p = 0; p < paths; ++p) {
       const int px = x + kOffsets[p];
       const bool inside = prev != nullptr && px >= 0 && px < g.width;
-      const uint8_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
+      const uint8_t* lp = inside ? prev[p] + px * g.block : zero;
       const uint8_t mp = inside ? prev_min[p][px] : 0;
       const uint8_t p2 = inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
-      uint8_t* out = cur[p] + x * g.block + kPathPad;
+      uint8_t* out = cur[p] + x * g.block;
       cur_min[p][x] = Step(cost + x * d_count, lp, mp, p1, p2, d_count, out);
       for (int k = 0; k < d_count; ++k) {
         dst[x * d_count + k] = static_cast<uint16_t>(dst[x * d_count + k] + out[k]);

@@ -146,10 +146,10 @@ void HorizontalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row, const S
                     const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
   const int d_count = g.disparities;
   const int w = g.width;
-  uint8_t* a0 = scratch + kPathPad;
-  uint8_t* b0 = scratch + g.block + kPathPad;
-  uint8_t* a1 = scratch + 2 * g.block + kPathPad;
-  uint8_t* b1 = scratch + 3 * g.block + kPathPad;
+  uint8_t* a0 = scratch;
+  uint8_t* b0 = scratch + g.block;
+  uint8_t* a1 = scratch + 2 * g.block;
+  uint8_t* b1 = scratch + 3 * g.block;
   std::fill(a0, a0 + d_count, uint8_t{0});
   std::fill(a1, a1 + d_count, uint8_t{0});
   uint8_t min0 = 0, min1 = 0;
@@ -176,21 +176,20 @@ void VerticalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
                   const uint16_t* src, uint16_t* dst) {
   const int d_count = g.disparities;
   static constexpr int kOffsets[3] = {0, -1, 1};
-  HWY_ALIGN uint8_t zero_block[512 + 2 * kPathPad];
+  HWY_ALIGN uint8_t zero_block[kPathLead + 512 + kPathTail];
   HWY_ALIGN uint16_t partial[512];  // sums of the earlier paths of one pixel
-  std::fill(zero_block, zero_block + g.block, uint8_t{0});
-  zero_block[kPathPad - 1] = kPathSentinel;
-  zero_block[kPathPad + d_count] = kPathSentinel;
-  const uint8_t* zero = zero_block + kPathPad;
+  std::fill(zero_block, zero_block + kPathLead + g.block, kPathSentinel);
+  std::fill(zero_block + kPathLead, zero_block + kPathLead + d_count, uint8_t{0});
+  const uint8_t* zero = zero_block + kPathLead;
   for (int x = 0; x < g.width; ++x) {
     for (int p = 0; p < paths; ++p) {
       const int px = x + kOffsets[p];
       const bool inside = prev != nullptr && px >= 0 && px < g.width;
-      const uint8_t* lp = inside ? prev[p] + px * g.block + kPathPad : zero;
+      const uint8_t* lp = inside ? prev[p] + px * g.block : zero;
       const uint8_t mp = inside ? prev_min[p][px] : 0;
       const uint8_t p2 =
           inside ? p2_table[std::abs(image_row[x] - prev_image_row[px])] : p2_table[0];
-      uint8_t* out = cur[p] + x * g.block + kPathPad;
+      uint8_t* out = cur[p] + x * g.block;
       const uint16_t* s = p == 0 ? src + x * d_count : partial;
       const uint8_t* c = cost + x * d_count;
       if (p + 1 < paths) {
