@@ -337,7 +337,7 @@ TEST(SgmMatcherTest, RejectsBadInputAndOptions) {
   o.p2 = o.p1;
   EXPECT_FALSE(SgmMatcher::Create(o).ok());
   o = SgmOptions();
-  o.p2 = 120;  // 31 + 240 > 255
+  o.p2 = 127;  // 12 census bits + 254 > 255
   EXPECT_FALSE(SgmMatcher::Create(o).ok());
 
   auto m = SgmMatcher::Create(SgmOptions());

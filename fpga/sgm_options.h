@@ -13,11 +13,12 @@ struct SgmOptions {
   int64_t min_disparity = 0;       // px
   int64_t num_disparities = 128;   // px, a multiple of 16; disparities [min, min + num)
   // Center-symmetric census window: (w*h - 1) / 2 comparisons of opposite pixel pairs, <= 32.
-  int64_t census_width = 9;
-  int64_t census_height = 7;
+  // 5x5 (12 bits) scored better than 9x7 on the Middlebury pairs and costs half as much.
+  int64_t census_width = 5;
+  int64_t census_height = 5;
   int64_t paths = 4;               // 4 (horizontal + vertical) or 8 (plus diagonals)
-  int64_t p1 = 10;                 // penalty for a disparity change of 1 px
-  int64_t p2 = 60;                 // penalty for larger changes; census bits + 2 p2 <= 255
+  int64_t p1 = 6;                  // penalty for a disparity change of 1 px
+  int64_t p2 = 40;                 // penalty for larger changes; census bits + 2 p2 <= 255
   // P2 falls to p2 * s / (s + |dI|) across an intensity step dI (but not below p1 + 1): depth
   // edges usually coincide with intensity edges. 0 keeps P2 constant.
   int64_t p2_intensity_scale = 16;  // gray levels
