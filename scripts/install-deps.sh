@@ -9,9 +9,10 @@ packages=(
   # libraries
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libhwy-dev
   # tools used by tests and scripts
   systemd iproute2 can-utils util-linux python3
+  # dense stereo (fpga/): Google Highway SIMD
+  libhwy-dev
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)
