@@ -10,7 +10,13 @@ packages=(
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
   libgtest-dev libgmock-dev libbenchmark-dev libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev
   # tools used by tests and scripts
+<<<<<<< HEAD
   systemd iproute2 can-utils util-linux file
+=======
+  systemd iproute2 can-utils util-linux python3
+  # dense stereo (fpga/): Google Highway SIMD
+  libhwy-dev
+>>>>>>> stereo
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)

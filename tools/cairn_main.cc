@@ -15,6 +15,9 @@ constexpr auto kCommands = std::to_array<Command>({
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
     {"mcap info", "summarize MCAP recordings (also ones cut short by a crash)", RunMcapInfo},
     {"trajectory convert", "convert trajectories between TUM, EuRoC CSV and KITTI", RunTrajectoryConvert},
+    {"stereo", "dense disparity of a stereo pair (SGM), written as PFM", RunStereo},
+    {"stereo-eval", "score a disparity PFM against Middlebury/KITTI ground truth (JSON)", RunStereoEval},
+    {"bench stereo", "time our SGM against OpenCV StereoSGBM side by side", RunBenchStereo},
 });
 
 void PrintHelp() {

@@ -10,3 +10,11 @@ int RunMcapInfo(const CommandArgs& args);
 int RunTrajectoryConvert(const CommandArgs& args);
 
 }  // namespace cairn::tools
+
+namespace cairn::tools {
+
+int RunStereo(const CommandArgs& args);
+int RunStereoEval(const CommandArgs& args);
+int RunBenchStereo(const CommandArgs& args);
+
+}  // namespace cairn::tools

@@ -1,0 +1,66 @@
+#pragma once
+// The row kernels of Semi-Global Matching. SgmMatcher owns the buffers, the threading and the
+// per-pixel decisions; a backend only supplies these loops. The scalar set is the golden model;
+// the Highway set must give the same result for every input (all arithmetic is integer).
+//
+// Layouts: a cost row is width * D uint8 and a sum row width * D uint16 (disparity index k
+// fastest, k = d - d_min). A path row is kPathLead sentinel bytes followed by one block of
+// `block` = D + kPathTail uint8 per pixel: lanes [0, D) are the path costs, the rest hold
+// kPathSentinel, so lane D and lane -1 (the previous block's tail, or the lead) never win as
+// +-1 neighbours. Pointers to path rows point at the first block. Path costs fit 8 bits because SgmOptions::Validate demands
+// census_bits + 2 * p2 <= 255: a path cost is at most C + P2 and the jump term min + P2 at most
+// census_bits + 2 * P2, so no addition overflows and none saturates.
+
+#include <cstddef>
+#include <cstdint>
+
+namespace cairn {
+
+inline constexpr uint8_t kPathSentinel = 0xFF;
+inline constexpr int kPathLead = 64;
+inline constexpr int kPathTail = 16;  // small blocks: the path rows are the working set
+
+struct SgmRowGeometry {
+  int width = 0;
+  int disparities = 0;  // D, a multiple of 16
+  int block = 0;        // D + kPathTail
+  int min_disparity = 0;
+  // Reversed right-census index of (x, k): rev_base - x + k (see SgmKernels::cost).
+  int rev_base = 0;
+};
+
+struct SgmKernels {
+  // Center-symmetric census of one row. `center` points at pixel (0, y) inside an image padded by
+  // (cw/2, ch/2) replicated pixels on every side; bit order: pairs in raster order, first pair
+  // in the most significant used bit.
+  void (*census)(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch,
+                 uint32_t* out);
+  // cost[x*D + k] = max(popcount(left[x] ^ right(i)), border[i]), i = rev_base - x + k, where
+  // right(i) is the reversed right census stored as `planes` byte planes: byte b of right(i) is
+  // right_planes[b * plane_stride + i] (planes = ceil(census bits / 8); the other bytes are 0).
+  void (*cost)(const uint32_t* left, const uint8_t* right_planes, int plane_stride, int planes,
+               const uint8_t* border, const SgmRowGeometry& g, uint8_t* cost);
+  // The left-to-right and right-to-left paths; sum = their sum. scratch: a path row of 4 blocks.
+  void (*horizontal)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                     const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum);
+  // `paths` (1 or 3) paths arriving from the previous row at x, x-1, x+1. prev == nullptr on the
+  // first row of a sweep. dst[x*D + k] = src[...] + sum of the new path costs (dst may be src).
+  // stream_dst hints that dst is not read again soon (a backend may bypass the cache).
+  void (*vertical)(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
+                   const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
+                   uint8_t* const* prev, const uint8_t* const* prev_min, uint8_t* const* cur,
+                   uint8_t* const* cur_min, const uint16_t* src, uint16_t* dst, bool stream_dst);
+  // Winner-take-all of one sum row. best[x] = argmin_k (smallest k on ties), or -1 - best when
+  // the uniqueness test fails. right_best[xr] = argmin_k sum(xr + d_min + k, k) over the row, -1
+  // where no candidate exists. scratch: 2 * (rev_base + D + 1) uint16.
+  void (*wta)(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent,
+              uint16_t* scratch, int16_t* best, int16_t* right_best);
+};
+
+const SgmKernels& ScalarSgmKernels();
+// Highway implementation for the best target of this CPU (AVX2, SSE4, NEON, ...).
+const SgmKernels& SimdSgmKernels();
+// Name of the Highway target SimdSgmKernels() dispatches to, for reports.
+const char* SimdTargetName();
+
+}  // namespace cairn

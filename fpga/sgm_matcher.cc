@@ -1,0 +1,343 @@
+#include "fpga/sgm_matcher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "mapping/stereo_error_model.h"
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
+namespace cairn {
+namespace {
+
+constexpr int kMaxSide = 16384;
+
+// Asks for transparent huge pages on the whole-frame sum volume: it is written and read once per
+// frame in long streams, and 2 MB pages save most of the TLB misses. Only a hint.
+void AdviseHugePages(void* p, size_t bytes) {
+#ifdef __linux__
+  constexpr uintptr_t kHuge = uintptr_t{2} << 20;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
+template <class T>
+hwy::AlignedFreeUniquePtr<T[]> AllocateBuffer(size_t n, size_t* bytes) {
+  *bytes += n * sizeof(T);
+  return hwy::AllocateAligned<T>(n);
+}
+
+}  // namespace
+
+Expected<std::unique_ptr<SgmMatcher>> SgmMatcher::Create(const SgmOptions& options) {
+  CAIRN_RETURN_IF_ERROR(options.Validate());
+  return std::unique_ptr<SgmMatcher>(new SgmMatcher(options));
+}
+
+SgmMatcher::SgmMatcher(const SgmOptions& options)
+    : options_(options),
+      kernels_(options.backend == SgmBackend::kScalar ? &ScalarSgmKernels() : &SimdSgmKernels()),
+      pool_(static_cast<int>(options.threads)),
+      rx_(static_cast<int>(options.census_width / 2)),
+      ry_(static_cast<int>(options.census_height / 2)) {
+  const int p1 = static_cast<int>(options.p1), p2 = static_cast<int>(options.p2);
+  const int s = static_cast<int>(options.p2_intensity_scale);
+  for (int di = 0; di < 256; ++di) {
+    const int v = s > 0 ? std::max(p1 + 1, p2 * s / (s + di)) : p2;
+    p2_table_[di] = static_cast<uint8_t>(v);
+  }
+}
+
+std::string_view SgmMatcher::name() const {
+  return options_.backend == SgmBackend::kScalar ? "sgm-scalar" : "sgm-simd";
+}
+
+void SgmMatcher::Allocate(int width, int height) {
+  width_ = width;
+  height_ = height;
+  buffer_bytes_ = 0;
+  const int d = static_cast<int>(options_.num_disparities);
+  const int dmin = static_cast<int>(options_.min_disparity);
+  geometry_.width = width;
+  geometry_.disparities = d;
+  geometry_.block = d + kPathTail;
+  geometry_.min_disparity = dmin;
+  geometry_.rev_base = width - 1 + dmin + std::max(0, -dmin);
+  const size_t w = static_cast<size_t>(width), h = static_cast<size_t>(height);
+  // 64 spare bytes per row let SIMD census loads run past the right border.
+  pad_stride_ = static_cast<ptrdiff_t>(w + 2 * rx_ + 64);
+  const size_t pad_bytes = static_cast<size_t>(pad_stride_) * (h + 2 * ry_);
+  pad_left_ = AllocateBuffer<uint8_t>(pad_bytes, &buffer_bytes_);
+  pad_right_ = AllocateBuffer<uint8_t>(pad_bytes, &buffer_bytes_);
+  std::memset(pad_left_.get(), 0, pad_bytes);
+  std::memset(pad_right_.get(), 0, pad_bytes);
+  census_left_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+  census_right_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+  sum_ = AllocateBuffer<uint16_t>(w * h * d, &buffer_bytes_);
+  AdviseHugePages(sum_.get(), w * h * d * sizeof(uint16_t));
+  raw_ = AllocateBuffer<int16_t>(w * h, &buffer_bytes_);
+  filtered_ = AllocateBuffer<int16_t>(w * h, &buffer_bytes_);
+  const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
+  for (Sweep& s : sweeps_) {
+    s.cost = AllocateBuffer<uint8_t>(w * d, &buffer_bytes_);
+    s.row_sum = AllocateBuffer<uint16_t>(w * d, &buffer_bytes_);
+    s.horizontal_scratch = AllocateBuffer<uint8_t>(kPathLead + 4 * geometry_.block, &buffer_bytes_);
+    s.wta_scratch = AllocateBuffer<uint16_t>(2 * n_rev, &buffer_bytes_);
+    std::fill_n(s.horizontal_scratch.get(), kPathLead + 4 * geometry_.block, kPathSentinel);
+    for (int b = 0; b < 2; ++b) {
+      for (int p = 0; p < 3; ++p) {
+        // Sentinels fill the block pads once; the kernels only ever write lanes [0, D).
+        s.path[b][p] = AllocateBuffer<uint8_t>(kPathLead + w * geometry_.block, &buffer_bytes_);
+        std::fill_n(s.path[b][p].get(), kPathLead + w * geometry_.block, kPathSentinel);
+        s.path_min[b][p] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
+      }
+    }
+    s.right_planes = AllocateBuffer<uint8_t>(4 * n_rev, &buffer_bytes_);
+    s.border = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
+    s.best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
+    s.right_best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
+  }
+}
+
+void SgmMatcher::PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, int y1) const {
+  // Rows y0..y1 of the padded image (in padded coordinates), borders replicated.
+  const int w = width_;
+  for (int py = y0; py < y1; ++py) {
+    const int sy = std::clamp(py - ry_, 0, height_ - 1);
+    const uint8_t* s = src + static_cast<ptrdiff_t>(sy) * stride;
+    uint8_t* t = dst + py * pad_stride_;
+    std::memset(t, s[0], static_cast<size_t>(rx_));
+    std::memcpy(t + rx_, s, static_cast<size_t>(w));
+    std::memset(t + rx_ + w, s[w - 1], static_cast<size_t>(rx_));
+  }
+}
+
+void SgmMatcher::ComputeCost(Sweep& s, int y) {
+  const SgmRowGeometry& g = geometry_;
+  const int n_rev = g.rev_base + g.disparities;
+  const int plane_stride = n_rev + 64;  // as allocated: 4 planes of n_rev + 64 bytes
+  const int planes = (options_.census_bits() + 7) / 8;
+  const int pad = g.rev_base - (width_ - 1) - g.min_disparity;  // = max(0, -d_min)
+  const uint32_t* cr = census_right_.get() + static_cast<size_t>(y) * width_;
+  const uint8_t border_cost = static_cast<uint8_t>(options_.census_bits());
+  uint8_t* rp = s.right_planes.get();
+  for (int i = 0; i < n_rev; ++i) {
+    const int xr = width_ - 1 + pad - i;
+    const bool inside = xr >= 0 && xr < width_;
+    const uint32_t c = inside ? cr[xr] : 0u;
+    for (int b = 0; b < planes; ++b) rp[b * plane_stride + i] = static_cast<uint8_t>(c >> (8 * b));
+    s.border[i] = inside ? 0 : border_cost;
+  }
+  kernels_->cost(census_left_.get() + static_cast<size_t>(y) * width_, rp, plane_stride, planes,
+                 s.border.get(), g, s.cost.get());
+}
+
+void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
+  const SgmRowGeometry& g = geometry_;
+  const uint8_t p1 = static_cast<uint8_t>(options_.p1);
+  const int paths = options_.paths == 8 ? 3 : 1;
+  ComputeCost(s, y);
+  uint16_t* sum_row = sum_.get() + static_cast<size_t>(y) * width_ * g.disparities;
+  // First visit: the horizontal paths go to the row buffer, and the volume row is written once
+  // (streamed past the cache: the other sweep reads it much later). Second visit: the volume row
+  // plus this sweep's paths land in the row buffer for winner-take-all.
+  if (!finish) {
+    kernels_->horizontal(s.cost.get(), image_row(y), g, p2_table_, p1,
+                         s.horizontal_scratch.get() + kPathLead, s.row_sum.get());
+  }
+  const int prev = 1 - s.cur;
+  uint8_t* prev_paths[3];
+  const uint8_t* prev_min[3];
+  uint8_t* cur_paths[3];
+  uint8_t* cur_min[3];
+  for (int p = 0; p < 3; ++p) {
+    prev_paths[p] = s.path[prev][p].get() + kPathLead;
+    prev_min[p] = s.path_min[prev][p].get();
+    cur_paths[p] = s.path[s.cur][p].get() + kPathLead;
+    cur_min[p] = s.path_min[s.cur][p].get();
+  }
+  kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr, g,
+                     paths, p2_table_, p1, s.has_prev ? prev_paths : nullptr, prev_min,
+                     cur_paths, cur_min, finish ? sum_row : s.row_sum.get(),
+                     finish ? s.row_sum.get() : sum_row, /*stream_dst=*/!finish);
+  s.cur = prev;
+  s.has_prev = true;
+  s.prev_y = y;
+  if (finish) FinishRow(s, y);
+}
+
+void SgmMatcher::FinishRow(Sweep& s, int y) {
+  const SgmRowGeometry& g = geometry_;
+  const int d_count = g.disparities;
+  kernels_->wta(s.row_sum.get(), g, static_cast<int>(options_.uniqueness_percent),
+                s.wta_scratch.get(), s.best.get(), s.right_best.get());
+  int16_t* out = raw_.get() + static_cast<size_t>(y) * width_;
+  const int max_diff = static_cast<int>(options_.lr_max_diff);
+  for (int x = 0; x < width_; ++x) {
+    out[x] = kInvalidDisparity;
+    const int k = s.best[x];
+    if (k < 0) continue;  // not unique
+    const int d = g.min_disparity + k;
+    const int xr = x - d;
+    if (xr < 0 || xr >= width_) continue;  // matched outside the right image
+    if (options_.lr_check) {
+      const int kr = s.right_best[xr];
+      if (kr < 0 || std::abs(kr - k) > max_diff) continue;
+    }
+    int value = d * kDisparityScale;
+    if (options_.subpixel && k > 0 && k < d_count - 1) {
+      // Equiangular (V-shaped) fit through the winner and its neighbours, in 1/16 px with
+      // round-half-away-from-zero so that the result is symmetric.
+      const uint16_t* sr = s.row_sum.get() + static_cast<size_t>(x) * d_count;
+      const int a = sr[k - 1], c = sr[k + 1], m = sr[k];
+      const int den = std::max(a, c) - m;
+      if (den > 0) {
+        const int num = (a - c) * (kDisparityScale / 2);
+        value += num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+      }
+    }
+    out[x] = static_cast<int16_t>(value);
+  }
+}
+
+void SgmMatcher::ComputeDepth(const StereoMatcherInput& input, StereoMatcherOutput* out, int y0,
+                              int y1) const {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const bool geometry = input.focal_px > 0.0 && input.baseline_m > 0.0;
+  const StereoErrorModel model(geometry ? input.focal_px : 1.0, geometry ? input.baseline_m : 1.0,
+                               options_.pixel_error_px);
+  const double fb = input.focal_px * input.baseline_m;
+  for (int y = y0; y < y1; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const size_t i = static_cast<size_t>(y) * width_ + x;
+      const int16_t d = out->disparity[i];
+      const double disp = static_cast<double>(d) / kDisparityScale + input.disparity_offset_px;
+      if (!geometry || d == kInvalidDisparity || disp <= 0.0) {
+        out->depth[i] = nan;
+        out->depth_sigma[i] = nan;
+        continue;
+      }
+      const double z = fb / disp;
+      out->depth[i] = static_cast<float>(z);
+      out->depth_sigma[i] = static_cast<float>(model.DepthError(z));
+    }
+  }
+}
+
+Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* output) {
+  if (output == nullptr) return InvalidArgumentError("SgmMatcher::Match: output is null");
+  if (input.left == nullptr || input.right == nullptr) {
+    return InvalidArgumentError("SgmMatcher::Match: left or right image is null");
+  }
+  if (input.width < 1 || input.height < 1 || input.width > kMaxSide || input.height > kMaxSide) {
+    return InvalidArgumentError("SgmMatcher::Match: image size " + std::to_string(input.width) +
+                                "x" + std::to_string(input.height) + " outside 1.." +
+                                std::to_string(kMaxSide));
+  }
+  if (input.stride < input.width) {
+    return InvalidArgumentError("SgmMatcher::Match: stride " + std::to_string(input.stride) +
+                                " is smaller than the width " + std::to_string(input.width));
+  }
+  if (input.width != width_ || input.height != height_) Allocate(input.width, input.height);
+  const int w = width_, h = height_;
+  const size_t n = static_cast<size_t>(w) * h;
+  if (output->width != w || output->height != h || output->disparity.size() != n) {
+    output->width = w;
+    output->height = h;
+    output->disparity.resize(n);
+    output->depth.resize(n);
+    output->depth_sigma.resize(n);
+  }
+  using Clock = std::chrono::steady_clock;
+  auto mark = Clock::now();
+  const auto lap = [&mark](double* ms) {
+    const auto now = Clock::now();
+    *ms = std::chrono::duration<double, std::milli>(now - mark).count();
+    mark = now;
+  };
+  const int tasks = pool_.threads();
+  const auto band = [&](int t, int count, int* y0, int* y1) {
+    *y0 = static_cast<int>(static_cast<int64_t>(count) * t / tasks);
+    *y1 = static_cast<int>(static_cast<int64_t>(count) * (t + 1) / tasks);
+  };
+
+  // Pad and census, row bands in parallel.
+  const int pad_rows = h + 2 * ry_;
+  pool_.ForEach(tasks, [&](int t) {
+    int y0, y1;
+    band(t, pad_rows, &y0, &y1);
+    PadImage(input.left, input.stride, pad_left_.get(), y0, y1);
+    PadImage(input.right, input.stride, pad_right_.get(), y0, y1);
+  });
+  pool_.ForEach(tasks, [&](int t) {
+    int y0, y1;
+    band(t, h, &y0, &y1);
+    for (int y = y0; y < y1; ++y) {
+      const ptrdiff_t off = (y + ry_) * pad_stride_ + rx_;
+      kernels_->census(pad_left_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
+                       static_cast<int>(options_.census_height), census_left_.get() + static_cast<size_t>(y) * w);
+      kernels_->census(pad_right_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
+                       static_cast<int>(options_.census_height), census_right_.get() + static_cast<size_t>(y) * w);
+    }
+  });
+
+  lap(&times_.census_ms);
+  // The two sweeps (see the header): sweep 0 top-down, sweep 1 bottom-up.
+  const int half = h / 2;
+  for (Sweep& s : sweeps_) s.has_prev = false;
+  pool_.ForEach(2, [&](int t) {
+    if (t == 0) {
+      for (int y = 0; y < half; ++y) SweepRow(sweeps_[0], y, false);
+    } else {
+      for (int y = h - 1; y >= half; --y) SweepRow(sweeps_[1], y, false);
+    }
+  });
+  lap(&times_.first_half_ms);
+  pool_.ForEach(2, [&](int t) {
+    if (t == 0) {
+      for (int y = half; y < h; ++y) SweepRow(sweeps_[0], y, true);
+    } else {
+      for (int y = half - 1; y >= 0; --y) SweepRow(sweeps_[1], y, true);
+    }
+  });
+
+  lap(&times_.second_half_ms);
+  // Post-filters, shared by every backend.
+  int16_t* disp = raw_.get();
+  if (options_.median) {
+    pool_.ForEach(tasks, [&](int t) {
+      int y0, y1;
+      band(t, h, &y0, &y1);
+      DisparityFilter::Median3x3(raw_.get(), filtered_.get(), w, h, y0, y1);
+    });
+    disp = filtered_.get();
+  }
+  lap(&times_.median_ms);
+  filter_.RemoveSpeckles(disp, w, h, static_cast<int>(options_.speckle_max_size),
+                         static_cast<int>(options_.speckle_max_diff));
+  if (options_.fill_holes) {
+    for (int y = 0; y < h; ++y) DisparityFilter::FillHolesRow(disp + static_cast<size_t>(y) * w, w);
+  }
+  lap(&times_.speckle_ms);
+  std::copy(disp, disp + n, output->disparity.begin());
+  pool_.ForEach(tasks, [&](int t) {
+    int y0, y1;
+    band(t, h, &y0, &y1);
+    ComputeDepth(input, output, y0, y1);
+  });
+  lap(&times_.depth_ms);
+  return Status::Ok();
+}
+
+}  // namespace cairn

@@ -1,0 +1,91 @@
+#pragma once
+// CPU Semi-Global Matching (Hirschmueller 2008) behind the StereoMatcher interface, with either
+// the scalar golden-model kernels or the Highway SIMD kernels; both give identical disparities.
+//
+// Schedule: the sum volume S (W x H x D uint16, the only full-size buffer) is filled by two row
+// sweeps, a top-down one carrying the paths that arrive from the row above and a bottom-up one
+// carrying those from the row below. Each sweep first covers its own half of the image (also
+// adding the two horizontal paths there), then continues into the other half, where S already
+// holds every other path, and finishes each row with winner-take-all. The two sweeps run on two
+// threads without ever touching the same row at the same time; the sums are integers, so the
+// result does not depend on the thread count.
+
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+#include <hwy/aligned_allocator.h>
+
+#include "fpga/disparity_filter.h"
+#include "fpga/sgm_kernels.h"
+#include "fpga/sgm_options.h"
+#include "fpga/stereo_matcher_interface.h"
+#include "fpga/worker_pool.h"
+
+namespace cairn {
+
+class SgmMatcher final : public StereoMatcher {
+ public:
+  static Expected<std::unique_ptr<SgmMatcher>> Create(const SgmOptions& options);
+
+  std::string_view name() const override;
+  Status Match(const StereoMatcherInput& input, StereoMatcherOutput* output) override;
+
+  const SgmOptions& options() const { return options_; }
+  // Bytes held for the current image size.
+  size_t buffer_bytes() const { return buffer_bytes_; }
+
+  // Wall time of the stages of the last Match(), for benchmarks.
+  struct StageTimes {
+    double census_ms = 0, first_half_ms = 0, second_half_ms = 0, median_ms = 0, speckle_ms = 0,
+           depth_ms = 0;
+  };
+  const StageTimes& last_stage_times() const { return times_; }
+
+ private:
+  template <class T>
+  using Buffer = hwy::AlignedFreeUniquePtr<T[]>;
+
+  struct Sweep {
+    Buffer<uint8_t> cost, horizontal_scratch;
+    Buffer<uint16_t> row_sum, wta_scratch;
+    Buffer<uint8_t> path[2][3];  // [prev/cur][path]
+    Buffer<uint8_t> path_min[2][3];
+    Buffer<uint8_t> right_planes, border;  // reversed right census row (sgm_kernels.h)
+    Buffer<int16_t> best, right_best;
+    int cur = 0;          // which of path[0], path[1] receives the next row
+    bool has_prev = false;
+    int prev_y = -1;
+  };
+
+  explicit SgmMatcher(const SgmOptions& options);
+  void Allocate(int width, int height);
+  void PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, int y1) const;
+  void ComputeCost(Sweep& s, int y);
+  // Aggregates row y in a sweep; with `finish` the row is complete afterwards and gets its
+  // disparities.
+  void SweepRow(Sweep& s, int y, bool finish);
+  void FinishRow(Sweep& s, int y);
+  void ComputeDepth(const StereoMatcherInput& input, StereoMatcherOutput* out, int y0, int y1) const;
+  const uint8_t* image_row(int y) const { return pad_left_.get() + (y + ry_) * pad_stride_ + rx_; }
+
+  SgmOptions options_;
+  const SgmKernels* kernels_;
+  WorkerPool pool_;
+  uint8_t p2_table_[256];
+  int rx_ = 0, ry_ = 0;
+
+  int width_ = 0, height_ = 0;
+  SgmRowGeometry geometry_;
+  ptrdiff_t pad_stride_ = 0;
+  Buffer<uint8_t> pad_left_, pad_right_;
+  Buffer<uint32_t> census_left_, census_right_;
+  Buffer<uint16_t> sum_;
+  Buffer<int16_t> raw_, filtered_;
+  Sweep sweeps_[2];
+  DisparityFilter filter_;
+  size_t buffer_bytes_ = 0;
+  StageTimes times_;
+};
+
+}  // namespace cairn
