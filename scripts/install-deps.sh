@@ -8,15 +8,13 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   # libraries
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # recording (MCAP chunks) and the live Foxglove stream
+  libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev nodejs
   # tools used by tests and scripts
-<<<<<<< HEAD
-  systemd iproute2 can-utils util-linux file
-=======
-  systemd iproute2 can-utils util-linux python3
+  systemd iproute2 can-utils util-linux file python3
   # dense stereo (fpga/): Google Highway SIMD
   libhwy-dev
->>>>>>> stereo
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)
@@ -28,6 +26,9 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+# Tests that check outputs with third-party JavaScript clients need npm; some nodejs builds ship it,
+# Debian's comes as its own package.
+if ! command -v npm >/dev/null; then missing+=(npm); fi
 if ((${#missing[@]} == 0)); then
   echo "install-deps: all ${#packages[@]} packages present"
   exit 0
