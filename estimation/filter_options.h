@@ -37,8 +37,10 @@ struct FilterOptions {
 
   // Static initialization.
   double init_duration = 1.0;        // s of still IMU data averaged
-  double init_max_gyro = 0.05;       // rad/s; any larger rate restarts the still window
-  double init_max_accel_dev = 0.3;   // m/s^2; deviation of |a| from its window mean
+  double init_block = 0.1;           // s; samples averaged before the stillness checks
+  double init_max_gyro = 0.2;        // rad/s; larger rates (beyond any plausible bias) are motion
+  double init_max_gyro_dev = 0.01;   // rad/s; deviation from the window's mean rate
+  double init_max_accel_dev = 0.1;   // m/s^2; deviation from the window mean and of |a| from g
   double init_sigma_roll_pitch = 0.01;  // rad
   double init_sigma_velocity = 0.02;    // m/s
   double init_sigma_accel_bias = 0.1;   // m/s^2
@@ -65,7 +67,9 @@ struct FilterOptions {
     v.Number("max_imu_gap", max_imu_gap, 1e-4, 10.0, "s");
     v.Integer("imu_resync_samples", imu_resync_samples, 1, 100000, "samples");
     v.Number("init_duration", init_duration, 0.01, 60.0, "s");
+    v.Number("init_block", init_block, 0.0, 5.0, "s");
     v.Number("init_max_gyro", init_max_gyro, 0.0, 10.0, "rad/s");
+    v.Number("init_max_gyro_dev", init_max_gyro_dev, 0.0, 10.0, "rad/s");
     v.Number("init_max_accel_dev", init_max_accel_dev, 0.0, 20.0, "m/s^2");
     v.Number("init_sigma_roll_pitch", init_sigma_roll_pitch, 1e-6, 1.0, "rad");
     v.Number("init_sigma_velocity", init_sigma_velocity, 1e-6, 10.0, "m/s");

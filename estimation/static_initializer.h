@@ -2,8 +2,11 @@
 // Static initialization from a still period: roll and pitch from the mean specific force, gyro
 // bias from the mean rate, yaw zero (the local frame's yaw is arbitrary).
 //
-// Policy when the robot moves: any sample with a rate above init_max_gyro or a specific-force
-// magnitude further than init_max_accel_dev from gravity restarts the still window. The filter
+// Samples are averaged in blocks of init_block seconds first, so that vibration (a multicopter
+// idling on the ground) does not count as motion. Policy when the robot moves: a block whose mean
+// rate or specific force leaves the window's mean (init_max_gyro_dev, init_max_accel_dev), whose
+// mean rate exceeds init_max_gyro or whose mean specific force is further than
+// init_max_accel_dev from gravity in magnitude restarts the window. The filter
 // reports "not initialized" until a full window has been collected; it never initializes from
 // moving data, because a wrong gravity direction would corrupt every later estimate. A robot that
 // cannot stand still is initialized explicitly with LocalReferenceFilter::Initialize().
@@ -32,8 +35,11 @@ class StaticInitializer {
 
  private:
   FilterOptions options_;
-  Timestamp start_;
+  Timestamp start_, block_start_;
   int count_ = 0;
+  int block_count_ = 0;
+  Eigen::Vector3d block_accel_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d block_gyro_ = Eigen::Vector3d::Zero();
   int restarts_ = 0;
   Eigen::Vector3d sum_accel_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d sum_gyro_ = Eigen::Vector3d::Zero();
