@@ -53,6 +53,22 @@ struct FilterState {
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();
   std::array<CloneSlot, kMaxClones> clones{};
   StateCovariance P = StateCovariance::Zero();
+  // Propagation only changes the core-clone cross-covariance by left-multiplication with the
+  // transition matrix, so it is accumulated here and applied once, before anything reads it:
+  // the true cross block is phi * P.topRightCorner (see MaterializeCovariance).
+  Eigen::Matrix<double, kCoreDim, kCoreDim> phi = Eigen::Matrix<double, kCoreDim, kCoreDim>::Identity();
+  bool cross_pending = false;
 };
+
+// Applies the accumulated transition to the core-clone cross-covariance, making P complete.
+inline void MaterializeCovariance(FilterState& s) {
+  if (!s.cross_pending) return;
+  constexpr int kCloneDims = kStateDim - kCoreDim;
+  const Eigen::Matrix<double, kCoreDim, kCloneDims> cross = s.phi * s.P.topRightCorner<kCoreDim, kCloneDims>();
+  s.P.topRightCorner<kCoreDim, kCloneDims>() = cross;
+  s.P.bottomLeftCorner<kCloneDims, kCoreDim>() = cross.transpose();
+  s.phi.setIdentity();
+  s.cross_pending = false;
+}
 
 }  // namespace cairn

@@ -11,6 +11,7 @@ template <int M>
 UpdateOutcome KalmanUpdate(FilterState& s, const Eigen::Matrix<double, M, kStateDim>& H,
                            const Eigen::Matrix<double, M, 1>& r,
                            const Eigen::Matrix<double, M, M>& R, double gate) {
+  MaterializeCovariance(s);
   const Eigen::Matrix<double, kStateDim, M> PHt = s.P * H.transpose();
   Eigen::Matrix<double, M, M> S = H * PHt + R;
   S = 0.5 * (S + S.transpose()).eval();
@@ -65,7 +66,9 @@ void RelativePoseModel(const FilterState& s, const RelativePoseMeasurement& m, E
 
 }  // namespace
 
-Matrix6d RelativePoseCovariance(const FilterState& s, const RelativePoseMeasurement& m) {
+Matrix6d RelativePoseCovariance(const FilterState& state, const RelativePoseMeasurement& m) {
+  FilterState s = state;  // a copy: the deferred cross-covariance must be applied
+  MaterializeCovariance(s);
   Eigen::Vector3d t_hat;
   Eigen::Quaterniond q_hat;
   Eigen::Matrix<double, 6, kStateDim> H;

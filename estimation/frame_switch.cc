@@ -9,6 +9,7 @@ namespace cairn {
 
 FrameTransform SwitchFrame(FilterState& s, const Eigen::Isometry3d& T_imu_body,
                            StateCovariance& J, StateCovariance& JP) {
+  MaterializeCovariance(s);
   const Eigen::Matrix3d R = s.q.toRotationMatrix();
   const Eigen::Vector3d t_ib = T_imu_body.translation();
   const Eigen::Vector3d lever = R * t_ib;

@@ -62,14 +62,13 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   f.theta_theta = dq.toRotationMatrix().transpose();
   f.theta_bg = -so3::RightJacobian(phi) * dt;
 
-  // P <- Phi P Phi^T + Q, touching only the 15 core rows and columns.
-  Eigen::Matrix<double, kCoreDim, kStateDim> top = s.P.topRows<kCoreDim>();
-  ApplyTransitionRows(f, top);
-  Eigen::Matrix<double, kCoreDim, kCoreDim> core = top.leftCols<kCoreDim>().transpose();
+  // P_core <- Phi P_core Phi^T + Q; the cross block with the clones is deferred (phi <- Phi phi).
+  Eigen::Matrix<double, kCoreDim, kCoreDim> half = s.P.topLeftCorner<kCoreDim, kCoreDim>();
+  ApplyTransitionRows(f, half);
+  Eigen::Matrix<double, kCoreDim, kCoreDim> core = half.transpose();
   ApplyTransitionRows(f, core);
-  s.P.topRightCorner<kCoreDim, kStateDim - kCoreDim>() = top.rightCols<kStateDim - kCoreDim>();
-  s.P.bottomLeftCorner<kStateDim - kCoreDim, kCoreDim>() =
-      top.rightCols<kStateDim - kCoreDim>().transpose();
+  ApplyTransitionRows(f, s.phi);
+  s.cross_pending = true;
 
   const double qa = noise_.accel_noise_density * noise_.accel_noise_density;
   const double qg = noise_.gyro_noise_density * noise_.gyro_noise_density;

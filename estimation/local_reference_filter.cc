@@ -77,6 +77,8 @@ void LocalReferenceFilter::Initialize(Timestamp time, const Eigen::Vector3d& p,
   state_.gyro = first_sample.gyro;
   state_.clones.fill(CloneSlot{});
   state_.P.setZero();
+  state_.phi.setIdentity();
+  state_.cross_pending = false;
   state_.P.topLeftCorner<15, 15>() = 0.5 * (covariance + covariance.transpose());
   initialized_ = true;
   have_last_imu_ = true;
@@ -320,6 +322,7 @@ int LocalReferenceFilter::active_clones() const {
 
 void LocalReferenceFilter::Marginalize(int slot) {
   // Dropping a clone's rows and columns is exact marginalization of a Gaussian.
+  MaterializeCovariance(state_);
   const int ic = CloneIndex(slot);
   state_.P.middleRows<6>(ic).setZero();
   state_.P.middleCols<6>(ic).setZero();
@@ -352,6 +355,7 @@ void LocalReferenceFilter::AddClone(CloneId id) {
   c.q_frame_imu = state_.q;
   c.last_used = state_.time;
   // The clone's error equals the current pose error: copy those rows, then those columns.
+  MaterializeCovariance(state_);
   const int ic = CloneIndex(slot);
   state_.P.middleRows<3>(ic) = state_.P.middleRows<3>(kP);
   state_.P.middleRows<3>(ic + 3) = state_.P.middleRows<3>(kTheta);

@@ -172,6 +172,7 @@ void ExpectDelayedEqualsInOrder(double delay, double switch_period) {
   EXPECT_LT((x.ba - y.ba).norm(), 1e-9);
   EXPECT_LT((x.bg - y.bg).norm(), 1e-9);
   EXPECT_LT((x.P - y.P).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((x.phi - y.phi).cwiseAbs().maxCoeff(), 1e-9);
   for (int i = 0; i < kMaxClones; ++i) {
     EXPECT_EQ(x.clones[i].id, y.clones[i].id);
     EXPECT_LT((x.clones[i].p_frame_imu - y.clones[i].p_frame_imu).norm(), 1e-9);

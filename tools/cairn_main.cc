@@ -13,6 +13,7 @@ namespace {
 constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
+    {"bench filter", "time the local reference filter (propagation, delayed updates, switches)", RunBenchFilter},
 });
 
 void PrintHelp() {

@@ -6,5 +6,6 @@ namespace cairn::tools {
 
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
+int RunBenchFilter(const CommandArgs& args);
 
 }  // namespace cairn::tools
