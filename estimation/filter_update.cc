@@ -7,12 +7,27 @@
 namespace cairn {
 namespace {
 
+// P H^T for an H that is zero outside the core columns.
+template <int M>
+Eigen::Matrix<double, kStateDim, M> CorePHt(const FilterState& s, const Eigen::Matrix<double, M, kStateDim>& H) {
+  return s.P.leftCols<kCoreDim>() * H.template leftCols<kCoreDim>().transpose();
+}
+
+// P H^T for an H that is zero outside two clone blocks.
+Eigen::Matrix<double, kStateDim, 6> ClonePHt(const FilterState& s, const Eigen::Matrix<double, 6, kStateDim>& H,
+                                             int ik, int ic) {
+  Eigen::Matrix<double, kStateDim, 6> PHt = s.P.middleCols<6>(ik) * H.middleCols<6>(ik).transpose();
+  PHt.noalias() += s.P.middleCols<6>(ic) * H.middleCols<6>(ic).transpose();
+  return PHt;
+}
+
+// The EKF update given P H^T (computed by the caller, exploiting H's sparsity). P must be
+// materialized (MaterializeCovariance) before PHt is formed.
 template <int M>
 UpdateOutcome KalmanUpdate(FilterState& s, const Eigen::Matrix<double, M, kStateDim>& H,
+                           const Eigen::Matrix<double, kStateDim, M>& PHt,
                            const Eigen::Matrix<double, M, 1>& r,
                            const Eigen::Matrix<double, M, M>& R, double gate) {
-  MaterializeCovariance(s);
-  const Eigen::Matrix<double, kStateDim, M> PHt = s.P * H.transpose();
   Eigen::Matrix<double, M, M> S = H * PHt + R;
   S = 0.5 * (S + S.transpose()).eval();
   const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
@@ -84,7 +99,10 @@ UpdateOutcome ApplyRelativePoseUpdate(FilterState& s, const RelativePoseMeasurem
   Eigen::Matrix<double, 6, 1> r;
   r.head<3>() = m.t_k_c - t_hat;
   r.tail<3>() = so3::Log(q_hat.conjugate() * m.q_k_c);
-  return KalmanUpdate<6>(s, H, r, m.covariance, gate);
+  MaterializeCovariance(s);
+  const Eigen::Matrix<double, kStateDim, 6> PHt =
+      ClonePHt(s, H, CloneIndex(m.keyframe_slot), CloneIndex(m.current_slot));
+  return KalmanUpdate<6>(s, H, PHt, r, m.covariance, gate);
 }
 
 UpdateOutcome ApplyBodyVelocityUpdate(FilterState& s, const Eigen::Matrix3d& R_imu_meas,
@@ -102,20 +120,24 @@ UpdateOutcome ApplyBodyVelocityUpdate(FilterState& s, const Eigen::Matrix3d& R_i
   H3.block<3, 3>(0, kTheta) = A * so3::Skew(v_imu);
   H3.block<3, 3>(0, kBg) = A * so3::Skew(p_imu_point);
   const Eigen::Vector3d r3 = velocity - predicted;
+  MaterializeCovariance(s);
   if (rows == 2) {
-    return KalmanUpdate<2>(s, H3.topRows<2>(), r3.head<2>(), cov.topLeftCorner<2, 2>(), 0.0);
+    const Eigen::Matrix<double, 2, kStateDim> H2 = H3.topRows<2>();
+    return KalmanUpdate<2>(s, H2, CorePHt<2>(s, H2), r3.head<2>(), cov.topLeftCorner<2, 2>(), 0.0);
   }
   if (rows == 1) {
-    return KalmanUpdate<1>(s, H3.topRows<1>(), r3.head<1>(), cov.topLeftCorner<1, 1>(), 0.0);
+    const Eigen::Matrix<double, 1, kStateDim> H1 = H3.topRows<1>();
+    return KalmanUpdate<1>(s, H1, CorePHt<1>(s, H1), r3.head<1>(), cov.topLeftCorner<1, 1>(), 0.0);
   }
-  return KalmanUpdate<3>(s, H3, r3, cov, 0.0);
+  return KalmanUpdate<3>(s, H3, CorePHt<3>(s, H3), r3, cov, 0.0);
 }
 
 UpdateOutcome ApplyPositionUpdate(FilterState& s, const Eigen::Vector3d& p,
                                   const Eigen::Matrix3d& cov) {
   Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Zero();
   H.block<3, 3>(0, kP).setIdentity();
-  return KalmanUpdate<3>(s, H, Eigen::Vector3d(p - s.p), cov, 0.0);
+  MaterializeCovariance(s);
+  return KalmanUpdate<3>(s, H, CorePHt<3>(s, H), Eigen::Vector3d(p - s.p), cov, 0.0);
 }
 
 }  // namespace cairn
