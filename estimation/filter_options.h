@@ -48,6 +48,9 @@ struct FilterOptions {
 
   // Wheel odometry.
   bool wheel_enabled = false;
+  // Side slip of each wheel assumed zero with this sigma when wheel speeds are turned into a body
+  // velocity.
+  double wheel_lateral_sigma = 0.05;  // m/s
   // Rover profiles: body z velocity is zero (non-holonomic pseudo-measurement).
   bool nonholonomic = false;
   double nonholonomic_sigma = 0.05;  // m/s
@@ -76,6 +79,7 @@ struct FilterOptions {
     v.Number("init_sigma_accel_bias", init_sigma_accel_bias, 1e-6, 10.0, "m/s^2");
     v.Number("init_sigma_gyro_bias", init_sigma_gyro_bias, 1e-7, 1.0, "rad/s");
     v.Flag("wheel_enabled", wheel_enabled);
+    v.Number("wheel_lateral_sigma", wheel_lateral_sigma, 1e-4, 10.0, "m/s");
     v.Flag("nonholonomic", nonholonomic);
     v.Number("nonholonomic_sigma", nonholonomic_sigma, 1e-4, 10.0, "m/s");
     v.Number("relative_pose_gate", relative_pose_gate, 0.0, 1e6, "chi-square");

@@ -7,6 +7,7 @@
 
 #include "estimation/filter_update.h"
 #include "estimation/so3.h"
+#include "estimation/wheel_velocity.h"
 
 namespace cairn {
 namespace {
@@ -46,13 +47,16 @@ const char* FilterResultName(FilterResult r) {
     case FilterResult::kRejectedGate: return "rejected: innovation gate";
     case FilterResult::kRejectedBufferFull: return "rejected: buffer full";
     case FilterResult::kRejectedDisabled: return "rejected: disabled";
+    case FilterResult::kRejectedInvalid: return "rejected: invalid measurement";
   }
   return "unknown";
 }
 
-LocalReferenceFilter::LocalReferenceFilter(const FilterOptions& options, const ImuCalibration& imu)
+LocalReferenceFilter::LocalReferenceFilter(const FilterOptions& options, const ImuCalibration& imu,
+                                           const WheelCalibration& wheels)
     : options_(options),
       calibration_(imu),
+      wheels_(wheels),
       propagator_(ImuNoise::FromCalibration(imu), options.gravity),
       initializer_(options),
       imu_(static_cast<size_t>(std::clamp<int64_t>(options.imu_buffer, 16, kMaxImuBuffer))),
@@ -515,6 +519,16 @@ FilterResult LocalReferenceFilter::ApplyWheelOdometry(const BodyVelocity& veloci
   }
   Count(r, true);
   return r;
+}
+
+FilterResult LocalReferenceFilter::ApplyWheelOdometry(const WheelOdometrySample& sample) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  BodyVelocity v;
+  if (options_.wheel_enabled && !WheelBodyVelocity(sample, wheels_, options_.wheel_lateral_sigma, &v)) {
+    Count(FilterResult::kRejectedInvalid, true);
+    return FilterResult::kRejectedInvalid;
+  }
+  return ApplyWheelOdometry(v);
 }
 
 FilterResult LocalReferenceFilter::ApplyPosition(Timestamp time, const Eigen::Vector3d& p,

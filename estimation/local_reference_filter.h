@@ -30,6 +30,7 @@
 #include "estimation/static_initializer.h"
 #include "hal/calibration.h"
 #include "hal/imu_sample.h"
+#include "hal/wheel_odometry_sample.h"
 #include "hal/timestamp.h"
 
 namespace cairn {
@@ -49,6 +50,7 @@ enum class FilterResult : uint8_t {
   kRejectedGate,
   kRejectedBufferFull,
   kRejectedDisabled,
+  kRejectedInvalid,  // a wheel sample that does not determine the body velocity
 };
 const char* FilterResultName(FilterResult r);
 
@@ -112,7 +114,8 @@ struct FrameSwitchResult {
 
 class LocalReferenceFilter {
  public:
-  LocalReferenceFilter(const FilterOptions& options, const ImuCalibration& imu);
+  LocalReferenceFilter(const FilterOptions& options, const ImuCalibration& imu,
+                       const WheelCalibration& wheels = WheelCalibration{});
 
   // Starts the filter from a known state (else the first still window initializes it). The
   // covariance is the 15x15 core block.
@@ -131,6 +134,9 @@ class LocalReferenceFilter {
   FilterResult ApplyRelativePose(CloneId keyframe, CloneId current, const Eigen::Isometry3d& T_kf_cur,
                                  const Matrix6d& covariance);
   FilterResult ApplyWheelOdometry(const BodyVelocity& velocity);
+  // Per-wheel speeds and steering angles (hal), turned into a body velocity with the wheel
+  // calibration given at construction (estimation/wheel_velocity.h).
+  FilterResult ApplyWheelOdometry(const WheelOdometrySample& sample);
   // IMU position in the current local frame (external positioning, tests).
   FilterResult ApplyPosition(Timestamp time, const Eigen::Vector3d& p, const Eigen::Matrix3d& cov);
   // Switches to a new local frame at the body's current position and yaw, now.
@@ -182,6 +188,7 @@ class LocalReferenceFilter {
 
   FilterOptions options_;
   ImuCalibration calibration_;
+  WheelCalibration wheels_;
   ImuPropagator propagator_;
   StaticInitializer initializer_;
   FilterState state_;
