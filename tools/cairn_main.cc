@@ -18,6 +18,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"stereo", "dense disparity of a stereo pair (SGM), written as PFM", RunStereo},
     {"stereo-eval", "score a disparity PFM against Middlebury/KITTI ground truth (JSON)", RunStereoEval},
     {"bench stereo", "time our SGM against OpenCV StereoSGBM side by side", RunBenchStereo},
+    {"bench filter", "time the local reference filter (propagation, delayed updates, switches)", RunBenchFilter},
 });
 
 void PrintHelp() {

@@ -16,5 +16,6 @@ namespace cairn::tools {
 int RunStereo(const CommandArgs& args);
 int RunStereoEval(const CommandArgs& args);
 int RunBenchStereo(const CommandArgs& args);
+int RunBenchFilter(const CommandArgs& args);
 
 }  // namespace cairn::tools

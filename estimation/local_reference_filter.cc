@@ -1,0 +1,613 @@
+#include "estimation/local_reference_filter.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "estimation/filter_update.h"
+#include "estimation/so3.h"
+#include "estimation/wheel_velocity.h"
+
+namespace cairn {
+namespace {
+
+template <class M>
+bool CovarianceOk(const M& c) {
+  if (!c.allFinite()) return false;
+  if ((c - c.transpose()).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + c.cwiseAbs().maxCoeff())) return false;
+  Eigen::LLT<M> llt(c);
+  return llt.info() == Eigen::Success;
+}
+
+FilterResult FromOutcome(UpdateOutcome o) {
+  switch (o) {
+    case UpdateOutcome::kApplied: return FilterResult::kApplied;
+    case UpdateOutcome::kBadCovariance: return FilterResult::kRejectedBadCovariance;
+    case UpdateOutcome::kGated: return FilterResult::kRejectedGate;
+  }
+  return FilterResult::kRejectedBadCovariance;
+}
+
+}  // namespace
+
+const char* FilterResultName(FilterResult r) {
+  switch (r) {
+    case FilterResult::kApplied: return "applied";
+    case FilterResult::kPending: return "pending";
+    case FilterResult::kInitializing: return "initializing";
+    case FilterResult::kNotInitialized: return "not initialized";
+    case FilterResult::kRejectedNotFinite: return "rejected: not finite";
+    case FilterResult::kRejectedOutOfOrder: return "rejected: out of order";
+    case FilterResult::kRejectedDuplicate: return "rejected: duplicate time";
+    case FilterResult::kRejectedFarFuture: return "rejected: far future";
+    case FilterResult::kRejectedTooOld: return "rejected: too old";
+    case FilterResult::kRejectedUnknownClone: return "rejected: unknown clone";
+    case FilterResult::kRejectedBadCovariance: return "rejected: bad covariance";
+    case FilterResult::kRejectedGate: return "rejected: innovation gate";
+    case FilterResult::kRejectedBufferFull: return "rejected: buffer full";
+    case FilterResult::kRejectedDisabled: return "rejected: disabled";
+    case FilterResult::kRejectedInvalid: return "rejected: invalid measurement";
+  }
+  return "unknown";
+}
+
+LocalReferenceFilter::LocalReferenceFilter(const FilterOptions& options, const ImuCalibration& imu,
+                                           const WheelCalibration& wheels)
+    : options_(options),
+      calibration_(imu),
+      wheels_(wheels),
+      propagator_(ImuNoise::FromCalibration(imu), options.gravity),
+      initializer_(options),
+      imu_(static_cast<size_t>(std::clamp<int64_t>(options.imu_buffer, 16, kMaxImuBuffer))),
+      events_(static_cast<size_t>(std::clamp<int64_t>(options.event_log, 16, kMaxEventLog))),
+      snapshots_(static_cast<size_t>(std::clamp<int64_t>(options.snapshots, 2, kMaxSnapshots))),
+      history_(static_cast<size_t>(std::clamp<int64_t>(options.history, 2, kMaxHistory))) {
+  options_.max_clones = std::clamp<int64_t>(options_.max_clones, 2, kMaxClones);
+}
+
+void LocalReferenceFilter::Initialize(Timestamp time, const Eigen::Vector3d& p,
+                                      const Eigen::Vector3d& v, const Eigen::Quaterniond& q,
+                                      const Eigen::Vector3d& ba, const Eigen::Vector3d& bg,
+                                      const Eigen::Matrix<double, 15, 15>& covariance,
+                                      const ImuSample& first_sample) {
+  state_.time = time;
+  state_.p = p;
+  state_.v = v;
+  state_.q = q.normalized();
+  state_.ba = ba;
+  state_.bg = bg;
+  state_.accel = first_sample.accel;
+  state_.gyro = first_sample.gyro;
+  state_.clones.fill(CloneSlot{});
+  state_.P.setZero();
+  state_.phi.setIdentity();
+  state_.cross_pending = false;
+  state_.P.topLeftCorner<15, 15>() = 0.5 * (covariance + covariance.transpose());
+  initialized_ = true;
+  have_last_imu_ = true;
+  last_imu_time_ = time;
+  far_future_run_ = 0;
+
+  if (imu_end_ - imu_begin_ == imu_.size()) ++imu_begin_;
+  imu_[imu_end_ % imu_.size()] = first_sample;
+  const uint64_t k = imu_end_++;
+  history_begin_ = k;
+  WriteHistory(k);
+  ResetReplayWindow(imu_end_);
+}
+
+FilterResult LocalReferenceFilter::Propagate(const ImuSample& sample) {
+  if (!sample.accel.allFinite() || !sample.gyro.allFinite()) {
+    ++counters_.imu_not_finite;
+    return FilterResult::kRejectedNotFinite;
+  }
+  bool resync = false;
+  if (have_last_imu_) {
+    if (sample.time == last_imu_time_) {
+      ++counters_.imu_duplicate;
+      return FilterResult::kRejectedDuplicate;
+    }
+    if (sample.time < last_imu_time_) {
+      ++counters_.imu_out_of_order;
+      return FilterResult::kRejectedOutOfOrder;
+    }
+    if ((sample.time - last_imu_time_).seconds() > options_.max_imu_gap) {
+      // A run of samples that agree with each other but not with the past is a real gap.
+      const bool continues = far_future_run_ > 0 && sample.time > far_future_last_ &&
+                             (sample.time - far_future_last_).seconds() <= options_.max_imu_gap;
+      far_future_run_ = continues ? far_future_run_ + 1 : 1;
+      far_future_last_ = sample.time;
+      if (far_future_run_ < options_.imu_resync_samples) {
+        ++counters_.imu_far_future;
+        return FilterResult::kRejectedFarFuture;
+      }
+      resync = true;
+      ++counters_.imu_resyncs;
+    }
+  }
+  far_future_run_ = 0;
+  have_last_imu_ = true;
+  last_imu_time_ = sample.time;
+
+  if (!initialized_) {
+    if (resync) initializer_.Reset();
+    if (!initializer_.Add(sample)) return FilterResult::kInitializing;
+    Eigen::Matrix<double, 15, 15> cov = Eigen::Matrix<double, 15, 15>::Zero();
+    const double s_rp = options_.init_sigma_roll_pitch;
+    cov.block<3, 3>(kV, kV).diagonal().setConstant(options_.init_sigma_velocity * options_.init_sigma_velocity);
+    // Roll and pitch uncertain, yaw defines the frame (zero uncertainty); expressed in the IMU
+    // frame through the attitude.
+    const Eigen::Quaterniond q = initializer_.Attitude();
+    const Eigen::Matrix3d R = q.toRotationMatrix();
+    const Eigen::Matrix3d cov_world = Eigen::Vector3d(s_rp * s_rp, s_rp * s_rp, 0.0).asDiagonal();
+    cov.block<3, 3>(kTheta, kTheta) = R.transpose() * cov_world * R;
+    cov.block<3, 3>(kBa, kBa).diagonal().setConstant(options_.init_sigma_accel_bias * options_.init_sigma_accel_bias);
+    cov.block<3, 3>(kBg, kBg).diagonal().setConstant(options_.init_sigma_gyro_bias * options_.init_sigma_gyro_bias);
+    Initialize(sample.time, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), q,
+               Eigen::Vector3d::Zero(), initializer_.mean_gyro(), cov, sample);
+    ++counters_.imu_accepted;
+    return FilterResult::kApplied;
+  }
+
+  if (imu_end_ - imu_begin_ == imu_.size()) ++imu_begin_;
+  imu_[imu_end_ % imu_.size()] = sample;
+  const uint64_t k = imu_end_++;
+  ++counters_.imu_accepted;
+  if (resync) {
+    // Restart integration at the new time; the unobserved interval adds its process noise.
+    const double gap = (sample.time - state_.time).seconds();
+    const ImuNoise n = ImuNoise::FromCalibration(calibration_);
+    state_.P.block<3, 3>(kV, kV).diagonal().array() += n.accel_noise_density * n.accel_noise_density * gap;
+    state_.P.block<3, 3>(kTheta, kTheta).diagonal().array() += n.gyro_noise_density * n.gyro_noise_density * gap;
+    state_.P.block<3, 3>(kBa, kBa).diagonal().array() += n.accel_random_walk * n.accel_random_walk * gap;
+    state_.P.block<3, 3>(kBg, kBg).diagonal().array() += n.gyro_random_walk * n.gyro_random_walk * gap;
+    state_.time = sample.time;
+    state_.accel = sample.accel;
+    state_.gyro = sample.gyro;
+    WriteHistory(k);
+    ResetReplayWindow(imu_end_);
+    return FilterResult::kApplied;
+  }
+  Step(k);
+  return FilterResult::kApplied;
+}
+
+void LocalReferenceFilter::Step(uint64_t k) {
+  const ImuSample& s = ImuAt(k);
+  current_imu_seq_ = k;
+  while (ev_next_ < ev_end_ && EventAt(ev_next_).time <= s.time) {
+    Event& e = EventAt(ev_next_);
+    if (e.time > state_.time) {
+      // Readings are linear in time between samples: interpolate at the event.
+      const double a = (e.time - state_.time).seconds() / (s.time - state_.time).seconds();
+      const Eigen::Vector3d accel = state_.accel + a * (s.accel - state_.accel);
+      const Eigen::Vector3d gyro = state_.gyro + a * (s.gyro - state_.gyro);
+      propagator_.Propagate(state_, e.time, accel, gyro);
+    }
+    ++ev_next_;
+    e.result = ProcessEvent(e);
+  }
+  propagator_.Propagate(state_, s.time, s.accel, s.gyro);
+  WriteHistory(k);
+}
+
+void LocalReferenceFilter::Insert(uint64_t pos, const Event& e) {
+  for (uint64_t s = ev_end_; s > pos; --s) EventAt(s) = EventAt(s - 1);
+  EventAt(pos) = e;
+  ++ev_end_;
+}
+
+bool LocalReferenceFilter::MakeRoom() {
+  if (ev_end_ - ev_begin_ < events_.size()) return true;
+  // Only processed events may go (their replay starts become unusable); pending ones stay.
+  if (ev_begin_ >= ev_next_) return false;
+  ++ev_begin_;
+  return true;
+}
+
+void LocalReferenceFilter::ProcessNow(const Event& e) {
+  Insert(ev_next_, e);
+  Event& stored = EventAt(ev_next_);
+  ++ev_next_;
+  current_imu_seq_ = imu_end_;
+  stored.result = ProcessEvent(stored);
+}
+
+FilterResult LocalReferenceFilter::Submit(Event e) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  if ((e.time - state_.time).seconds() > options_.max_event_lead) {
+    return FilterResult::kRejectedFarFuture;
+  }
+  if (!MakeRoom()) return FilterResult::kRejectedBufferFull;
+  uint64_t pos = ev_end_;
+  while (pos > ev_begin_ && EventAt(pos - 1).time > e.time) --pos;
+
+  if (e.time > state_.time) {
+    Insert(pos, e);
+    return FilterResult::kPending;
+  }
+  if (e.time == state_.time && pos == ev_next_) {
+    ProcessNow(e);
+    return EventAt(ev_next_ - 1).result;
+  }
+
+  // Late: restart from the newest saved state before the event's place, if still buffered.
+  uint64_t found = snap_end_;
+  if ((state_.time - e.time).seconds() <= options_.max_update_delay) {
+    for (uint64_t j = snap_end_; j > snap_begin_; --j) {
+      const Snapshot& sn = snapshots_[(j - 1) % snapshots_.size()];
+      if (sn.event_seq <= pos && sn.state.time <= e.time) {
+        if (sn.event_seq >= ev_begin_ && sn.imu_seq >= imu_begin_) found = j - 1;
+        break;
+      }
+    }
+  }
+  if (found == snap_end_) {
+    if (e.kind != EventKind::kRelativePose) return FilterResult::kRejectedTooOld;
+    // Both clones are still in the state: apply it now, at the present linearization point.
+    e.time = state_.time;
+    ProcessNow(e);
+    const FilterResult r = EventAt(ev_next_ - 1).result;
+    if (r == FilterResult::kApplied) ++counters_.updates_direct;
+    return r;
+  }
+
+  Insert(pos, e);
+  const Snapshot& sn = snapshots_[found % snapshots_.size()];
+  state_ = sn.state;
+  ev_next_ = sn.event_seq;
+  snap_end_ = found + 1;
+  replaying_ = true;
+  ++counters_.replays;
+  for (uint64_t k = sn.imu_seq; k < imu_end_; ++k) {
+    Step(k);
+    ++counters_.replayed_imu_samples;
+  }
+  // Events at exactly the newest sample time are processed by the last Step already.
+  replaying_ = false;
+  return EventAt(pos).result;
+}
+
+FilterResult LocalReferenceFilter::ProcessEvent(Event& e) {
+  switch (e.kind) {
+    case EventKind::kClone:
+      if (SlotOf(e.a) < 0) AddClone(e.a);
+      PushSnapshot(current_imu_seq_);
+      return FilterResult::kApplied;
+    case EventKind::kRelease: {
+      const int slot = SlotOf(e.a);
+      if (slot < 0) return FilterResult::kRejectedUnknownClone;
+      Marginalize(slot);
+      return FilterResult::kApplied;
+    }
+    case EventKind::kRelativePose: {
+      RelativePoseMeasurement m;
+      m.keyframe_slot = SlotOf(e.a);
+      m.current_slot = SlotOf(e.b);
+      if (m.keyframe_slot < 0 || m.current_slot < 0) return FilterResult::kRejectedUnknownClone;
+      m.t_k_c = e.vec;
+      m.q_k_c = e.rot;
+      m.covariance = e.cov;
+      const FilterResult r = FromOutcome(ApplyRelativePoseUpdate(state_, m, options_.relative_pose_gate));
+      if (r == FilterResult::kApplied) {
+        state_.clones[static_cast<size_t>(m.keyframe_slot)].last_used = state_.time;
+      }
+      return r;
+    }
+    case EventKind::kWheel: {
+      const Eigen::Isometry3d T_imu_body = calibration_.T_body_imu.inverse();
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      cov.topLeftCorner<2, 2>() = e.cov.topLeftCorner<2, 2>();
+      cov(2, 2) = options_.nonholonomic_sigma * options_.nonholonomic_sigma;
+      return FromOutcome(ApplyBodyVelocityUpdate(state_, T_imu_body.linear(),
+                                                 T_imu_body.translation(), e.vec, cov,
+                                                 options_.nonholonomic ? 3 : 2));
+    }
+    case EventKind::kPosition:
+      return FromOutcome(ApplyPositionUpdate(state_, e.vec, e.cov.topLeftCorner<3, 3>()));
+  }
+  return FilterResult::kRejectedDisabled;
+}
+
+int LocalReferenceFilter::SlotOf(CloneId id) const {
+  if (id == kNoClone) return -1;
+  for (int i = 0; i < kMaxClones; ++i) {
+    if (state_.clones[static_cast<size_t>(i)].id == id) return i;
+  }
+  return -1;
+}
+
+int LocalReferenceFilter::active_clones() const {
+  int n = 0;
+  for (const CloneSlot& c : state_.clones) n += c.id != kNoClone ? 1 : 0;
+  return n;
+}
+
+void LocalReferenceFilter::Marginalize(int slot) {
+  // Dropping a clone's rows and columns is exact marginalization of a Gaussian.
+  MaterializeCovariance(state_);
+  const int ic = CloneIndex(slot);
+  state_.P.middleRows<6>(ic).setZero();
+  state_.P.middleCols<6>(ic).setZero();
+  state_.clones[static_cast<size_t>(slot)] = CloneSlot{};
+  if (!replaying_) ++counters_.clones_marginalized;
+}
+
+void LocalReferenceFilter::AddClone(CloneId id) {
+  if (active_clones() >= options_.max_clones) {
+    // Bounded: drop the least recently used clone (created or referenced as keyframe longest ago).
+    int victim = -1;
+    for (int i = 0; i < kMaxClones; ++i) {
+      const CloneSlot& c = state_.clones[static_cast<size_t>(i)];
+      if (c.id == kNoClone) continue;
+      if (victim < 0) {
+        victim = i;
+        continue;
+      }
+      const CloneSlot& v = state_.clones[static_cast<size_t>(victim)];
+      if (c.last_used < v.last_used || (c.last_used == v.last_used && c.id < v.id)) victim = i;
+    }
+    Marginalize(victim);
+  }
+  int slot = 0;
+  while (state_.clones[static_cast<size_t>(slot)].id != kNoClone) ++slot;
+  CloneSlot& c = state_.clones[static_cast<size_t>(slot)];
+  c.id = id;
+  c.time = state_.time;
+  c.p_frame_imu = state_.p;
+  c.q_frame_imu = state_.q;
+  c.last_used = state_.time;
+  // The clone's error equals the current pose error: copy those rows, then those columns.
+  MaterializeCovariance(state_);
+  const int ic = CloneIndex(slot);
+  state_.P.middleRows<3>(ic) = state_.P.middleRows<3>(kP);
+  state_.P.middleRows<3>(ic + 3) = state_.P.middleRows<3>(kTheta);
+  state_.P.middleCols<3>(ic) = state_.P.middleCols<3>(kP);
+  state_.P.middleCols<3>(ic + 3) = state_.P.middleCols<3>(kTheta);
+}
+
+void LocalReferenceFilter::PushSnapshot(uint64_t imu_seq) {
+  if (snap_end_ - snap_begin_ == snapshots_.size()) {
+    ++snap_begin_;
+    // Events before the oldest replay start are never needed again.
+    ev_begin_ = std::max(ev_begin_, snapshots_[snap_begin_ % snapshots_.size()].event_seq);
+  }
+  Snapshot& sn = snapshots_[snap_end_ % snapshots_.size()];
+  sn.state = state_;
+  sn.imu_seq = imu_seq;
+  sn.event_seq = ev_next_;
+  ++snap_end_;
+}
+
+void LocalReferenceFilter::ResetReplayWindow(uint64_t imu_seq) {
+  ev_begin_ = ev_next_;
+  snap_begin_ = snap_end_;
+  PushSnapshot(imu_seq);
+}
+
+void LocalReferenceFilter::WriteHistory(uint64_t k) {
+  PoseSample& h = history_[k % history_.size()];
+  h.time = state_.time;
+  h.frame_id = frame_id_;
+  h.T_frame_body = Eigen::Isometry3d::Identity();
+  h.T_frame_body.linear() = state_.q.toRotationMatrix();
+  h.T_frame_body.translation() = state_.p;
+  h.T_frame_body = h.T_frame_body * calibration_.T_body_imu.inverse();
+  h.covariance.topLeftCorner<3, 3>() = state_.P.block<3, 3>(kP, kP);
+  h.covariance.topRightCorner<3, 3>() = state_.P.block<3, 3>(kP, kTheta);
+  h.covariance.bottomLeftCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kP);
+  h.covariance.bottomRightCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kTheta);
+  history_end_ = std::max(history_end_, k + 1);
+}
+
+CloneRequest LocalReferenceFilter::Clone(Timestamp trigger_time) {
+  CloneRequest out;
+  if (!initialized_) return out;
+  ++counters_.clones_requested;
+  Event e;
+  e.kind = EventKind::kClone;
+  e.time = trigger_time;
+  e.a = next_clone_id_;
+  out.result = Submit(e);
+  if (out.result == FilterResult::kApplied || out.result == FilterResult::kPending) {
+    out.id = next_clone_id_++;
+  } else {
+    ++counters_.events_rejected;
+  }
+  return out;
+}
+
+FilterResult LocalReferenceFilter::ReleaseClone(CloneId id) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  Event e;
+  e.kind = EventKind::kRelease;
+  e.time = state_.time;
+  e.a = id;
+  if (!MakeRoom()) {
+    ++counters_.events_rejected;
+    return FilterResult::kRejectedBufferFull;
+  }
+  // A release takes effect now; it is logged so that replays keep it.
+  ProcessNow(e);
+  const FilterResult r = EventAt(ev_next_ - 1).result;
+  if (r != FilterResult::kApplied) ++counters_.events_rejected;
+  return r;
+}
+
+void LocalReferenceFilter::Count(FilterResult r, bool measurement) {
+  if (r == FilterResult::kApplied || r == FilterResult::kPending) {
+    if (measurement && r == FilterResult::kApplied) ++counters_.updates_applied;
+    return;
+  }
+  if (measurement) {
+    ++counters_.updates_rejected;
+  } else {
+    ++counters_.events_rejected;
+  }
+}
+
+FilterResult LocalReferenceFilter::ApplyRelativePose(CloneId keyframe, CloneId current,
+                                                     const Eigen::Isometry3d& T_kf_cur,
+                                                     const Matrix6d& covariance) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  FilterResult r = FilterResult::kApplied;
+  if (!T_kf_cur.matrix().allFinite()) r = FilterResult::kRejectedNotFinite;
+  else if (!CovarianceOk(covariance)) r = FilterResult::kRejectedBadCovariance;
+  if (r != FilterResult::kApplied) {
+    Count(r, true);
+    return r;
+  }
+  // The measurement belongs to the current clone's exposure time, found in the event log (the
+  // clone may be gone from the live state and still be there at its exposure time), else in the
+  // live state (beyond the replay window).
+  Timestamp time;
+  bool known = false;
+  for (uint64_t s = ev_begin_; s < ev_end_ && !known; ++s) {
+    const Event& ev = EventAt(s);
+    if (ev.kind == EventKind::kClone && ev.a == current) {
+      time = ev.time;
+      known = true;
+    }
+  }
+  const int cslot = SlotOf(current);
+  if (!known && cslot >= 0) {
+    time = state_.clones[static_cast<size_t>(cslot)].time;
+    known = true;
+  }
+  if (!known) {
+    Count(FilterResult::kRejectedUnknownClone, true);
+    return FilterResult::kRejectedUnknownClone;
+  }
+
+  // Body-frame delta to IMU-frame delta: T_ik_ic = T_i_b T_bk_bc T_b_i.
+  const Eigen::Isometry3d& T_b_i = calibration_.T_body_imu;
+  const Eigen::Isometry3d T_i_b = T_b_i.inverse();
+  const Eigen::Isometry3d T_imu = T_i_b * T_kf_cur * T_b_i;
+  const Eigen::Matrix3d R_ib = T_i_b.linear();
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = R_ib;
+  J.topRightCorner<3, 3>() = -R_ib * T_kf_cur.linear() * so3::Skew(T_b_i.translation());
+  J.bottomRightCorner<3, 3>() = R_ib;
+
+  Event e;
+  e.kind = EventKind::kRelativePose;
+  e.time = time;
+  e.a = keyframe;
+  e.b = current;
+  e.vec = T_imu.translation();
+  e.rot = Eigen::Quaterniond(T_imu.linear()).normalized();
+  e.cov = J * covariance * J.transpose();
+  r = Submit(e);
+  Count(r, true);
+  return r;
+}
+
+FilterResult LocalReferenceFilter::ApplyWheelOdometry(const BodyVelocity& velocity) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  FilterResult r = FilterResult::kApplied;
+  if (!options_.wheel_enabled) r = FilterResult::kRejectedDisabled;
+  else if (!velocity.v_xy.allFinite()) r = FilterResult::kRejectedNotFinite;
+  else if (!CovarianceOk(velocity.covariance)) r = FilterResult::kRejectedBadCovariance;
+  if (r == FilterResult::kApplied) {
+    Event e;
+    e.kind = EventKind::kWheel;
+    e.time = velocity.time;
+    e.vec = Eigen::Vector3d(velocity.v_xy.x(), velocity.v_xy.y(), 0.0);
+    e.cov.topLeftCorner<2, 2>() = velocity.covariance;
+    r = Submit(e);
+  }
+  Count(r, true);
+  return r;
+}
+
+FilterResult LocalReferenceFilter::ApplyWheelOdometry(const WheelOdometrySample& sample) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  BodyVelocity v;
+  if (options_.wheel_enabled && !WheelBodyVelocity(sample, wheels_, options_.wheel_lateral_sigma, &v)) {
+    Count(FilterResult::kRejectedInvalid, true);
+    return FilterResult::kRejectedInvalid;
+  }
+  return ApplyWheelOdometry(v);
+}
+
+FilterResult LocalReferenceFilter::ApplyPosition(Timestamp time, const Eigen::Vector3d& p,
+                                                 const Eigen::Matrix3d& cov) {
+  if (!initialized_) return FilterResult::kNotInitialized;
+  FilterResult r = FilterResult::kApplied;
+  if (!p.allFinite()) r = FilterResult::kRejectedNotFinite;
+  else if (!CovarianceOk(cov)) r = FilterResult::kRejectedBadCovariance;
+  if (r == FilterResult::kApplied) {
+    Event e;
+    e.kind = EventKind::kPosition;
+    e.time = time;
+    e.vec = p;
+    e.cov.topLeftCorner<3, 3>() = cov;
+    r = Submit(e);
+  }
+  Count(r, true);
+  return r;
+}
+
+FrameSwitchResult LocalReferenceFilter::RequestFrameSwitch() {
+  FrameSwitchResult out;
+  if (!initialized_) return out;
+  out.time = state_.time;
+  out.old_frame_id = frame_id_;
+  out.transform = SwitchFrame(state_, calibration_.T_body_imu.inverse(), scratch_a_, scratch_b_);
+  ++frame_id_;
+  out.new_frame_id = frame_id_;
+  out.result = FilterResult::kApplied;
+  ++counters_.frame_switches;
+  ResetReplayWindow(imu_end_);
+  return out;
+}
+
+FilterOutput LocalReferenceFilter::Output() const {
+  FilterOutput o;
+  o.initialized = initialized_;
+  o.time = state_.time;
+  o.frame_id = frame_id_;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = state_.q.toRotationMatrix();
+  T.translation() = state_.p;
+  o.T_frame_body = T * calibration_.T_body_imu.inverse();
+  o.v_frame_imu = state_.v;
+  o.accel_bias = state_.ba;
+  o.gyro_bias = state_.bg;
+  o.covariance = state_.P.topLeftCorner<9, 9>();
+  return o;
+}
+
+bool LocalReferenceFilter::PoseAt(Timestamp time, PoseSample* out) const {
+  if (!initialized_ || history_end_ == 0) return false;
+  const uint64_t cap = history_.size();
+  const uint64_t first = std::max(history_begin_, history_end_ > cap ? history_end_ - cap : 0);
+  auto at = [&](uint64_t s) -> const PoseSample& { return history_[s % cap]; };
+  if (time < at(first).time || time > at(history_end_ - 1).time) return false;
+  uint64_t lo = first, hi = history_end_ - 1;  // find the first entry with time >= `time`
+  while (lo < hi) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    if (at(mid).time < time) lo = mid + 1; else hi = mid;
+  }
+  const PoseSample& b = at(lo);
+  if (b.time == time || lo == first) {
+    *out = b;
+    return true;
+  }
+  const PoseSample& a = at(lo - 1);
+  if (a.frame_id != b.frame_id) {
+    *out = (time - a.time) < (b.time - time) ? a : b;
+    return true;
+  }
+  const double u = (time - a.time).seconds() / (b.time - a.time).seconds();
+  *out = u < 0.5 ? a : b;
+  out->time = time;
+  const Eigen::Quaterniond qa(a.T_frame_body.linear()), qb(b.T_frame_body.linear());
+  out->T_frame_body.linear() = qa.slerp(u, qb).toRotationMatrix();
+  out->T_frame_body.translation() =
+      (1.0 - u) * a.T_frame_body.translation() + u * b.T_frame_body.translation();
+  return true;
+}
+
+}  // namespace cairn

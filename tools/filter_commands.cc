@@ -1,0 +1,87 @@
+// cairn bench filter [--samples N] [--delay S] [--switch-period S]: wall time per IMU
+// propagation, delayed relative-pose update, wheel update and frame switch of the local reference
+// filter on a simulated run (200 Hz IMU, 20 Hz clones and relative poses, 20 Hz wheel odometry).
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "estimation/filter_scenario.h"
+#include "tools/commands.h"
+
+namespace cairn::tools {
+namespace {
+
+struct Timings {
+  const char* name;
+  std::vector<double> us;
+};
+
+void PrintStats(const Timings& t, bool last) {
+  std::vector<double> v = t.us;
+  std::sort(v.begin(), v.end());
+  double mean = 0.0;
+  for (double x : v) mean += x / static_cast<double>(v.empty() ? 1 : v.size());
+  auto pct = [&](double p) {
+    if (v.empty()) return 0.0;
+    return v[std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size())))];
+  };
+  std::printf("    \"%s\": {\"count\": %zu, \"mean_us\": %.3f, \"median_us\": %.3f, \"p99_us\": %.3f, "
+              "\"max_us\": %.3f}%s\n",
+              t.name, v.size(), mean, pct(0.5), pct(0.99), v.empty() ? 0.0 : v.back(), last ? "" : ",");
+}
+
+}  // namespace
+
+int RunBenchFilter(const CommandArgs& args) {
+  long samples = 120000;
+  double delay = 0.25, switch_period = 10.0;
+  for (size_t i = 0; i < args.args.size(); ++i) {
+    const std::string a = args.args[i];
+    const bool has_value = i + 1 < args.args.size();
+    if (a == "--samples" && has_value) {
+      samples = std::strtol(args.args[++i], nullptr, 10);
+    } else if (a == "--delay" && has_value) {
+      delay = std::strtod(args.args[++i], nullptr);
+    } else if (a == "--switch-period" && has_value) {
+      switch_period = std::strtod(args.args[++i], nullptr);
+    } else {
+      std::fprintf(stderr, "usage: cairn bench filter [--samples N] [--delay S] [--switch-period S]\n");
+      return 2;
+    }
+  }
+  if (samples < 1000 || delay < 0.0 || delay > 0.45 || switch_period <= 0.0) {
+    std::fprintf(stderr, "cairn bench filter: need --samples >= 1000, 0 <= --delay <= 0.45, --switch-period > 0\n");
+    return 2;
+  }
+  testing::ScenarioOptions s;
+  s.duration = static_cast<double>(samples) / 200.0;
+  s.update_delay = delay;
+  s.wheel_rate = 20.0;
+  s.switch_period = switch_period;
+  FilterOptions o;
+  o.wheel_enabled = true;
+  testing::FilterScenario scenario(s, o);
+  std::vector<Timings> t = {{"imu_propagation", {}}, {"relative_pose_update", {}},
+                            {"wheel_update", {}}, {"frame_switch", {}}};
+  for (auto& x : t) x.us.reserve(static_cast<size_t>(samples));
+  while (scenario.Step([&](int kind, double seconds) { t[static_cast<size_t>(kind)].us.push_back(seconds * 1e6); })) {
+  }
+  const FilterCounters& c = scenario.filter().counters();
+  std::printf("{\n  \"benchmark\": \"filter\",\n  \"imu_rate_hz\": 200, \"update_rate_hz\": 20, "
+              "\"update_delay_s\": %.3f, \"max_clones\": %d,\n",
+              delay, kMaxClones);
+  std::printf("  \"imu_samples\": %zu, \"updates_applied\": %lu, \"updates_rejected\": %lu, "
+              "\"replays\": %lu, \"replayed_imu_samples\": %lu,\n",
+              t[0].us.size(), static_cast<unsigned long>(c.updates_applied),
+              static_cast<unsigned long>(c.updates_rejected), static_cast<unsigned long>(c.replays),
+              static_cast<unsigned long>(c.replayed_imu_samples));
+  std::printf("  \"timings\": {\n");
+  for (size_t i = 0; i < t.size(); ++i) PrintStats(t[i], i + 1 == t.size());
+  std::printf("  }\n}\n");
+  return 0;
+}
+
+}  // namespace cairn::tools
