@@ -1,18 +1,15 @@
 #include "daemon/pipeline.h"
 
+#include "hal/monotonic_clock.h"
+
 #include <spdlog/spdlog.h>
 
-#include <ctime>
 #include <thread>
 
 namespace cairn {
 namespace {
 
-int64_t MonotonicNs() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-}
+int64_t MonotonicNs() { return MonotonicClock().Now().nanoseconds(); }
 
 }  // namespace
 

@@ -6,8 +6,7 @@
 
 #include "daemon/json_writer.h"
 #include "daemon/protobuf_schema.h"
-
-#include <ctime>
+#include "hal/monotonic_clock.h"
 
 namespace cairn {
 
@@ -91,9 +90,7 @@ void TelemetryStage::Offer(SpscQueue<Item<T>>& queue, const T& value) {
 
 void TelemetryStage::PublishDiagnostics(const std::string& status) {
   if (!live_ || !live_->HasSubscribers(diagnostics_channel_)) return;
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  const Timestamp now = Timestamp::FromNanoseconds(static_cast<int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec);
+  const Timestamp now = MonotonicClock().Now();
   JsonWriter j(false);
   j.BeginObject().Field("status", status).Field("time_ns", now.nanoseconds()).EndObject();
   live_->Publish(diagnostics_channel_, now, {reinterpret_cast<const uint8_t*>(j.str().data()), j.str().size()});
