@@ -9,6 +9,7 @@ packages=(
   # libraries
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libceres-dev
   # tools used by tests and scripts
   systemd iproute2 can-utils util-linux python3
 )

@@ -13,6 +13,7 @@ namespace {
 constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
+    {"graph solve", "batch-solve a g2o pose graph (file or multi-robot dir) and print costs", RunGraphSolve},
 });
 
 void PrintHelp() {

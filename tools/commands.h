@@ -6,5 +6,6 @@ namespace cairn::tools {
 
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
+int RunGraphSolve(const CommandArgs& args);
 
 }  // namespace cairn::tools
