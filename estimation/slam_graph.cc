@@ -4,6 +4,7 @@
 
 #include <ceres/ceres.h>
 
+#include "estimation/chordal_initializer.h"
 #include "estimation/pose_factors.h"
 #include "estimation/so3.h"
 
@@ -139,10 +140,11 @@ void SlamGraph::AnchorToWorld(uint64_t key, const Pose3& pose) {
 void SlamGraph::Insert(const SlamFactor& f) {
   ceres::CostFunction* cost = nullptr;
   ceres::LossFunction* loss = IsRobustFactor(f.kind) ? cauchy_.get() : nullptr;
+  ceres::ResidualBlockId id = nullptr;
   if (f.kind == FactorKind::kPrior || f.kind == FactorKind::kAbsolutePose) {
     AnchorToWorld(f.a, f.z);
     cost = AbsolutePoseResidual::Create(f.z, f.information);
-    problem_->AddResidualBlock(cost, loss, variables_.at(f.a).block.get());
+    id = problem_->AddResidualBlock(cost, loss, variables_.at(f.a).block.get());
   } else if (f.kind == FactorKind::kAbsolutePosition) {
     // Translates a floating component onto the fix but keeps it floating: one position does not
     // fix its orientation.
@@ -156,7 +158,7 @@ void SlamGraph::Insert(const SlamFactor& f) {
       }
     }
     cost = AbsolutePositionResidual::Create(f.position, f.position_information);
-    problem_->AddResidualBlock(cost, loss, v.block.get());
+    id = problem_->AddResidualBlock(cost, loss, v.block.get());
   } else {
     const bool has_a = HasVariable(f.a), has_b = HasVariable(f.b);
     if (!has_a && !has_b) {
@@ -182,8 +184,11 @@ void SlamGraph::Insert(const SlamFactor& f) {
       }
     }
     cost = RelativePoseResidual::Create(f.z, f.information);
-    problem_->AddResidualBlock(cost, loss, variables_.at(f.a).block.get(), variables_.at(f.b).block.get());
+    id = problem_->AddResidualBlock(cost, loss, variables_.at(f.a).block.get(), variables_.at(f.b).block.get());
   }
+  double c = 0.0;
+  problem_->EvaluateResidualBlock(id, true, &c, nullptr, nullptr);
+  new_cost_ += c;
   factors_.push_back(f);
 }
 
@@ -201,6 +206,9 @@ SlamUpdateStats SlamGraph::Solve(int iterations, double seconds) {
   o.num_threads = 1;
   ceres::Solver::Summary summary;
   ceres::Solve(o, problem_.get(), &summary);
+  new_cost_ = 0.0;
+  unconverged_ = summary.termination_type != ceres::CONVERGENCE;
+  stats.solved = true;
   stats.iterations = static_cast<int>(summary.iterations.size()) - 1;
   stats.cost = summary.final_cost;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -208,7 +216,43 @@ SlamUpdateStats SlamGraph::Solve(int iterations, double seconds) {
 }
 
 SlamUpdateStats SlamGraph::Update() {
+  if (new_cost_ <= options_.update_min_cost && !unconverged_) return {};
+  if (options_.reinitialize_cost > 0.0 && new_cost_ > options_.reinitialize_cost) {
+    const auto start = std::chrono::steady_clock::now();
+    const bool reinitialized = ReinitializeChordal().ok();
+    SlamUpdateStats stats = SolveFull();
+    stats.reinitialized = reinitialized;
+    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return stats;
+  }
   return Solve(static_cast<int>(options_.update_iterations), options_.update_seconds);
+}
+
+Status SlamGraph::ReinitializeChordal() {
+  PoseGraph g;
+  // Anchors first: InitializeChordal keeps the first vertex of each component.
+  for (const auto& f : factors_) {
+    if (f.kind == FactorKind::kPrior || f.kind == FactorKind::kAbsolutePose) g.SetVertex(f.a, *Pose(f.a));
+  }
+  for (const auto& [key, v] : variables_) {
+    if (v.gauge) g.SetVertex(key, *Pose(key));
+  }
+  for (const auto& [key, v] : variables_) {
+    if (!g.HasVertex(key)) g.SetVertex(key, *Pose(key));
+  }
+  for (const auto& f : factors_) {
+    if (IsUnary(f.kind)) continue;
+    PoseGraphEdge e;
+    e.from = f.a;
+    e.to = f.b;
+    e.T_from_to = f.z;
+    e.information = f.information;
+    PoseGraph::SetIsotropicWeights(e);
+    g.AddEdge(e);
+  }
+  CAIRN_RETURN_IF_ERROR(InitializeChordal(g));
+  for (size_t i = 0; i < g.num_vertices(); ++i) PoseToBlock(g.poses()[i], variables_.at(g.ids()[i]).block.get());
+  return Status::Ok();
 }
 
 SlamUpdateStats SlamGraph::SolveFull() { return Solve(static_cast<int>(options_.full_iterations), 1e9); }

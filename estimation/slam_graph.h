@@ -70,6 +70,13 @@ struct SlamGraphOptions {
   char own_robot = 'a';
   double cauchy_c = 3.0;                 // eq. 4.10 on d, o, c and fixes; 0 disables
   int64_t update_iterations = 10;        // bounded incremental update
+  // Update() skips the solve while the factors added since the last one fit the current estimate
+  // within this cost (e.g. odometry extending a chain): nothing to re-optimize.
+  double update_min_cost = 1e-9;
+  // A large loop closure (new factors' cost above this) re-initializes the graph chordally
+  // (rotation-first, escapes the local minima an incremental warm start runs into) and solves it
+  // fully; 0 disables.
+  double reinitialize_cost = 50.0;
   double update_seconds = 0.01;
   int64_t full_iterations = 100;
   // Covariances are recomputed when a requested origin moved more than this since last time, or
@@ -83,6 +90,8 @@ struct SlamGraphOptions {
     if (!robot.empty()) own_robot = robot[0];
     v.Number("cauchy_c", cauchy_c, 0.0, 1e6, "sqrt(chi2)");
     v.Integer("update_iterations", update_iterations, 1, 1000, "iterations");
+    v.Number("update_min_cost", update_min_cost, 0.0, 1e6, "chi2/2");
+    v.Number("reinitialize_cost", reinitialize_cost, 0.0, 1e12, "chi2/2");
     v.Number("update_seconds", update_seconds, 1e-4, 10.0, "s");
     v.Integer("full_iterations", full_iterations, 1, 100000, "iterations");
     v.Number("covariance_translation_change", covariance_translation_change, 0.0, 100.0, "m");
@@ -91,6 +100,8 @@ struct SlamGraphOptions {
 };
 
 struct SlamUpdateStats {
+  bool solved = false;  // false when nothing needed re-optimizing
+  bool reinitialized = false;
   int iterations = 0;
   double seconds = 0.0;
   double cost = 0.0;  // Ceres cost (1/2 sum of robustified squared residuals)
@@ -109,6 +120,9 @@ class SlamGraph {
   SlamUpdateStats Update();
   // Optimization to convergence.
   SlamUpdateStats SolveFull();
+  // Chordal re-initialization of all variables from the binary factors (anchors: the variables of
+  // the prior and the floating components' gauges keep their poses).
+  Status ReinitializeChordal();
 
   bool HasVariable(uint64_t key) const { return variables_.count(key) != 0; }
   Expected<Pose3> Pose(uint64_t key) const;
@@ -152,6 +166,8 @@ class SlamGraph {
   std::vector<SlamFactor> pending_;
   std::vector<SlamFactor> factors_;                // inserted ones, for Chi2()
   size_t num_added_factors_ = 0;
+  double new_cost_ = 0.0;  // cost of the factors added since the last solve, at insertion
+  bool unconverged_ = false;  // the last bounded solve stopped early: the next Update() resumes it
   std::map<char, uint64_t> latest_submap_;
   // Covariance cache.
   std::map<uint64_t, std::pair<Pose3, Matrix6d>> covariance_cache_;

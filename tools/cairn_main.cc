@@ -14,6 +14,9 @@ constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
     {"graph solve", "batch-solve a g2o pose graph (file or multi-robot dir) and print costs", RunGraphSolve},
+    {"graph replay", "feed a g2o graph vertex by vertex into the online SLAM graph, time each update", RunGraphReplay},
+    {"graph inject", "add random false loop closures to a g2o graph (robustness tests)", RunGraphInject},
+    {"bench graph", "online SLAM graph on thesis-sized multi-robot graphs: update and covariance times", RunBenchGraph},
 });
 
 void PrintHelp() {
