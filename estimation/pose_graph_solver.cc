@@ -60,8 +60,11 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
     ceres::LossFunction* loss = nullptr;
     if (IsLoopClosure(e)) {
       if (options.outliers == Options::Outliers::kGnc) {
-        weights.push_back(std::make_unique<ceres::LossFunctionWrapper>(
-            new ceres::ScaledLoss(nullptr, 1.0, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP));
+        // The first solve uses a Cauchy loss (c = 1): a warm start that outliers do not drag far,
+        // which the local solver needs before GNC's rounds (its convex start is only convex for a
+        // global solver).
+        weights.push_back(std::make_unique<ceres::LossFunctionWrapper>(new ceres::CauchyLoss(1.0),
+                                                                       ceres::TAKE_OWNERSHIP));
         weight_of_edge[k] = static_cast<int>(weights.size()) - 1;
         loss = weights.back().get();
       } else {
@@ -120,6 +123,7 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
     evaluate();
     double mu = cbar2 / std::max(2.0 * max_r2 - cbar2, 1e-12);
     for (int round = 0; round < 100 && mu < 1e6; ++round) {
+      bool binary = true;  // every weight already 0 or 1: further rounds change nothing
       for (size_t k = 0; k < residuals.size(); ++k) {
         if (weight_of_edge[k] < 0) continue;
         const double s = r2[k];
@@ -130,10 +134,12 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
           w = 1.0;
         } else {
           w = std::sqrt(cbar2 * mu * (mu + 1.0) / s) - mu;
+          binary = false;
         }
         weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
             new ceres::ScaledLoss(nullptr, std::max(w, 1e-12), ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
       }
+      if (binary && round > 0) break;
       ceres::Solver::Summary round_summary;
       ceres::Solve(solver, &problem, &round_summary);
       summary.iterations += static_cast<int>(round_summary.iterations.size()) - 1;
