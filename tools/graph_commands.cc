@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "estimation/g2o_io.h"
+#include "estimation/graph_replay.h"
 #include "estimation/pose_graph_solver.h"
 #include "estimation/slam_graph.h"
 #include "estimation/so3.h"
@@ -142,14 +143,6 @@ int RunGraphSolve(const CommandArgs& args) {
 namespace cairn::tools {
 namespace {
 
-// Plain g2o ids (top byte 0) belong to robot 'a'.
-char RobotOfG2oKey(uint64_t id) {
-  const unsigned r = RobotOfKey(id);
-  return r == 0 ? 'a' : static_cast<char>(r);
-}
-
-uint64_t SubmapOfG2oKey(uint64_t id) { return VariableKey(VariableKind::kSubmap, RobotOfG2oKey(id), IndexOfKey(id)); }
-
 double Percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -184,53 +177,14 @@ int RunGraphReplay(const CommandArgs& args) {
     return 1;
   }
   PoseGraph& g = *graph;
-  // Vertex order: sorted ids; an edge is fed at the step where its later end appears.
-  std::vector<size_t> order(g.num_vertices());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return g.ids()[x] < g.ids()[y]; });
-  std::vector<size_t> rank(g.num_vertices());
-  for (size_t r = 0; r < order.size(); ++r) rank[order[r]] = r;
-  std::vector<std::vector<size_t>> edges_at(g.num_vertices());
-  for (size_t k = 0; k < g.edges().size(); ++k) {
-    const auto& e = g.edges()[k];
-    edges_at[std::max(rank[g.Find(e.from)], rank[g.Find(e.to)])].push_back(k);
-  }
-  options.own_robot = RobotOfG2oKey(g.ids()[order[0]]);
-  SlamGraph slam(options);
-  SlamFactor prior;
-  prior.kind = FactorKind::kPrior;
-  prior.a = SubmapOfG2oKey(g.ids()[order[0]]);
-  prior.information = Matrix6d::Identity() * 1e8;
-  if (!slam.AddFactor(prior).ok()) return 1;
-  std::vector<double> times;
-  int reinitializations = 0;
   const auto start = std::chrono::steady_clock::now();
-  for (size_t r = 0; r < order.size(); ++r) {
-    if (edges_at[r].empty()) continue;
-    const auto t0 = std::chrono::steady_clock::now();
-    for (size_t k : edges_at[r]) {
-      const auto& e = g.edges()[k];
-      SlamFactor f;
-      f.kind = IsLoopClosure(e) ? FactorKind::kMatch : FactorKind::kFrameSwitch;
-      f.a = SubmapOfG2oKey(e.from);
-      f.b = SubmapOfG2oKey(e.to);
-      f.z = e.T_from_to;
-      f.information = e.information;
-      const Status s = slam.AddFactor(f);
-      if (!s.ok()) {
-        std::fprintf(stderr, "cairn graph replay: edge %zu: %s\n", k, s.message().c_str());
-        return 1;
-      }
-    }
-    const SlamUpdateStats stats = slam.Update();
-    reinitializations += stats.reinitialized ? 1 : 0;
-    times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  auto replay = ReplayPoseGraph(g, options);
+  if (!replay.ok()) {
+    std::fprintf(stderr, "cairn graph replay: %s\n", replay.status().message().c_str());
+    return 1;
   }
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (size_t i = 0; i < g.num_vertices(); ++i) {
-    auto p = slam.Pose(SubmapOfG2oKey(g.ids()[i]));
-    if (p.ok()) g.poses()[i] = *p;
-  }
+  const std::vector<double>& times = replay->step_seconds;
   double mean = 0.0;
   for (double t : times) mean += t;
   mean /= static_cast<double>(std::max<size_t>(1, times.size()));
@@ -239,8 +193,8 @@ int RunGraphReplay(const CommandArgs& args) {
       "\"step_max_ms\": %.3f, \"reinitializations\": %d, \"total_seconds\": %.3f, \"unconnected\": %zu, \"sesync_cost\": %.10g, "
       "\"geodesic_chi2\": %.10g}\n",
       in.c_str(), times.size(), 1e3 * mean, 1e3 * Percentile(times, 0.99),
-      1e3 * (times.empty() ? 0.0 : *std::max_element(times.begin(), times.end())), reinitializations, total,
-      slam.Unconnected().size(), SeSyncCost(g), GeodesicChi2(g));
+      1e3 * (times.empty() ? 0.0 : *std::max_element(times.begin(), times.end())), replay->reinitializations,
+      total, replay->unconnected, SeSyncCost(g), GeodesicChi2(g));
   return 0;
 }
 
