@@ -89,7 +89,9 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   solver.max_num_iterations = static_cast<int>(options.max_iterations);
-  solver.function_tolerance = options.function_tolerance;
+  solver.function_tolerance = options.function_tolerance > 0.0 ? options.function_tolerance
+                              : options.objective == Options::Objective::kSeSync ? 1e-6
+                                                                                 : 1e-10;
   solver.gradient_tolerance = 1e-14;
   solver.parameter_tolerance = 1e-10;
   solver.num_threads = static_cast<int>(options.threads);
