@@ -25,6 +25,7 @@ constexpr const char* kSolveUsage =
     "usage: cairn graph solve IN.g2o|DIR [--out OUT.g2o] [--objective geodesic|sesync]\n"
     "                         [--init chordal|odometry|file] [--loss none|cauchy:C]\n"
     "                         [--outliers none|gnc] [--threads N] [--verbose]\n"
+    "                         [--tolerance REL (relative cost change that ends the solve)]\n"
     "                         [--reference SOLVED.g2o (prints the ATE against its vertices)]\n";
 
 bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, std::string& reference,
@@ -59,6 +60,9 @@ bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, 
       if (*end != '\0' || !(o.cauchy_c > 0.0)) return false;
     } else if (a == "--outliers" && (v == "none" || v == "gnc")) {
       o.outliers = v == "gnc" ? O::Outliers::kGnc : O::Outliers::kNone;
+    } else if (a == "--tolerance") {
+      o.function_tolerance = std::atof(v.c_str());
+      if (!(o.function_tolerance > 0.0 && o.function_tolerance < 1.0)) return false;
     } else if (a == "--reference") {
       reference = v;
     } else if (a == "--threads") {
