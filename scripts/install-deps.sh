@@ -11,6 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # recording (MCAP chunks) and the live Foxglove stream
   libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev nodejs
+  # SLAM graph back-end
+  libceres-dev
   # tools used by tests and scripts
   systemd iproute2 can-utils util-linux file python3
   # dense stereo (fpga/): Google Highway SIMD

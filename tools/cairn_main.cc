@@ -19,6 +19,10 @@ constexpr auto kCommands = std::to_array<Command>({
     {"stereo-eval", "score a disparity PFM against Middlebury/KITTI ground truth (JSON)", RunStereoEval},
     {"bench stereo", "time our SGM against OpenCV StereoSGBM side by side", RunBenchStereo},
     {"bench filter", "time the local reference filter (propagation, delayed updates, switches)", RunBenchFilter},
+    {"graph solve", "batch-solve a g2o pose graph (file or multi-robot dir) and print costs", RunGraphSolve},
+    {"graph replay", "feed a g2o graph vertex by vertex into the online SLAM graph, time each update", RunGraphReplay},
+    {"graph inject", "add random false loop closures to a g2o graph (robustness tests)", RunGraphInject},
+    {"bench graph", "online SLAM graph on thesis-sized multi-robot graphs: update and covariance times", RunBenchGraph},
 });
 
 void PrintHelp() {

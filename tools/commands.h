@@ -17,5 +17,9 @@ int RunStereo(const CommandArgs& args);
 int RunStereoEval(const CommandArgs& args);
 int RunBenchStereo(const CommandArgs& args);
 int RunBenchFilter(const CommandArgs& args);
+int RunGraphSolve(const CommandArgs& args);
+int RunGraphReplay(const CommandArgs& args);
+int RunGraphInject(const CommandArgs& args);
+int RunBenchGraph(const CommandArgs& args);
 
 }  // namespace cairn::tools

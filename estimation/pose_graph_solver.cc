@@ -1,0 +1,170 @@
+#include "estimation/pose_graph_solver.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "estimation/chordal_initializer.h"
+#include "estimation/pose_factors.h"
+
+namespace cairn {
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+// Squared whitened residual beyond which GNC rejects a closure: chi-square, 6 dof, 99.9 %.
+constexpr double kGncDefaultThreshold = 22.46;
+
+}  // namespace
+
+bool IsLoopClosure(const PoseGraphEdge& e) {
+  return !(RobotOfKey(e.from) == RobotOfKey(e.to) && e.to == e.from + 1);
+}
+
+Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options) {
+  using Options = PoseGraphSolverOptions;
+  PoseGraphSolveSummary summary;
+  const auto start = std::chrono::steady_clock::now();
+  if (options.init == Options::Init::kFile && !graph.has_initial_estimate()) {
+    return FailedPreconditionError("--init file: the graph has no vertex estimates");
+  }
+  if (options.init == Options::Init::kOdometry || !graph.has_initial_estimate()) {
+    InitializeFromSpanningTree(graph);
+  }
+  if (options.init == Options::Init::kChordal) CAIRN_RETURN_IF_ERROR(InitializeChordal(graph));
+  summary.init_seconds = Seconds(start);
+  summary.initial_sesync_cost = SeSyncCost(graph);
+
+  const size_t n = graph.num_vertices();
+  std::vector<double> blocks(7 * n);
+  for (size_t v = 0; v < n; ++v) PoseToBlock(graph.poses()[v], &blocks[7 * v]);
+
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  const auto manifold = MakePoseManifold();
+  std::unique_ptr<ceres::LossFunction> cauchy;
+  if (options.cauchy_c > 0.0) cauchy = std::make_unique<ceres::CauchyLoss>(options.cauchy_c);
+  // GNC weights live in ScaledLoss wrappers so they can change between rounds.
+  std::vector<std::unique_ptr<ceres::LossFunctionWrapper>> weights;
+  std::vector<ceres::ResidualBlockId> residuals;
+  std::vector<int> weight_of_edge(graph.edges().size(), -1);
+  for (size_t k = 0; k < graph.edges().size(); ++k) {
+    const auto& e = graph.edges()[k];
+    ceres::CostFunction* cost =
+        options.objective == Options::Objective::kSeSync
+            ? ChordalResidual::Create(e.T_from_to, e.kappa, e.tau)
+            : RelativePoseResidual::Create(e.T_from_to, e.information);
+    ceres::LossFunction* loss = nullptr;
+    if (IsLoopClosure(e)) {
+      if (options.outliers == Options::Outliers::kGnc) {
+        // The first solve uses a Cauchy loss (c = 1): a warm start that outliers do not drag far,
+        // which the local solver needs before GNC's rounds (its convex start is only convex for a
+        // global solver).
+        weights.push_back(std::make_unique<ceres::LossFunctionWrapper>(new ceres::CauchyLoss(1.0),
+                                                                       ceres::TAKE_OWNERSHIP));
+        weight_of_edge[k] = static_cast<int>(weights.size()) - 1;
+        loss = weights.back().get();
+      } else {
+        loss = cauchy.get();
+      }
+    }
+    residuals.push_back(problem.AddResidualBlock(cost, loss, &blocks[7 * graph.Find(e.from)],
+                                                 &blocks[7 * graph.Find(e.to)]));
+  }
+  const std::vector<int> component = graph.Components(&summary.components);
+  std::vector<bool> anchored(static_cast<size_t>(summary.components), false);
+  for (size_t v = 0; v < n; ++v) {
+    if (!problem.HasParameterBlock(&blocks[7 * v])) continue;
+    problem.SetManifold(&blocks[7 * v], manifold.get());
+    if (!anchored[static_cast<size_t>(component[v])]) {
+      anchored[static_cast<size_t>(component[v])] = true;
+      problem.SetParameterBlockConstant(&blocks[7 * v]);  // gauge of this component
+    }
+  }
+
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  solver.max_num_iterations = static_cast<int>(options.max_iterations);
+  solver.function_tolerance = options.function_tolerance > 0.0 ? options.function_tolerance
+                              : options.objective == Options::Objective::kSeSync ? 1e-6
+                                                                                 : 1e-10;
+  solver.gradient_tolerance = 1e-14;
+  solver.parameter_tolerance = 1e-10;
+  solver.num_threads = static_cast<int>(options.threads);
+  solver.minimizer_progress_to_stdout = options.verbose;
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(solver, &problem, &ceres_summary);
+  summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  summary.termination = ceres_summary.BriefReport();
+  if (options.verbose) std::fprintf(stderr, "%s\n", ceres_summary.FullReport().c_str());
+  if (options.outliers == Options::Outliers::kGnc) {
+    // Graduated non-convexity with the truncated-least-squares surrogate (Yang et al. 2020):
+    // threshold cbar^2 on the squared whitened residual, mu grows until the weights are binary.
+    const double cbar2 = options.cauchy_c > 0.0 ? options.cauchy_c * options.cauchy_c : kGncDefaultThreshold;
+    double max_r2 = 0.0;
+    std::vector<double> r2(graph.edges().size(), 0.0);
+    auto evaluate = [&] {
+      for (size_t k = 0; k < residuals.size(); ++k) {
+        if (weight_of_edge[k] < 0) continue;
+        // The raw squared residual, without the weight.
+        const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(residuals[k]);
+        std::vector<double*> params;
+        problem.GetParameterBlocksForResidualBlock(residuals[k], &params);
+        std::vector<double> r(static_cast<size_t>(f->num_residuals()));
+        f->Evaluate(params.data(), r.data(), nullptr);
+        double s = 0.0;
+        for (double x : r) s += x * x;
+        r2[k] = s;
+        max_r2 = std::max(max_r2, s);
+      }
+    };
+    evaluate();
+    double mu = cbar2 / std::max(2.0 * max_r2 - cbar2, 1e-12);
+    for (int round = 0; round < 100 && mu < 1e6; ++round) {
+      bool binary = true;  // every weight already 0 or 1: further rounds change nothing
+      for (size_t k = 0; k < residuals.size(); ++k) {
+        if (weight_of_edge[k] < 0) continue;
+        const double s = r2[k];
+        double w;
+        if (s >= (mu + 1.0) / mu * cbar2) {
+          w = 0.0;
+        } else if (s <= mu / (mu + 1.0) * cbar2) {
+          w = 1.0;
+        } else {
+          w = std::sqrt(cbar2 * mu * (mu + 1.0) / s) - mu;
+          binary = false;
+        }
+        weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
+            new ceres::ScaledLoss(nullptr, std::max(w, 1e-12), ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
+      }
+      if (binary && round > 0) break;
+      ceres::Solver::Summary round_summary;
+      ceres::Solve(solver, &problem, &round_summary);
+      summary.iterations += static_cast<int>(round_summary.iterations.size()) - 1;
+      evaluate();
+      mu *= 1.4;
+    }
+    // Final solve with binary weights: the optimum of the graph without the rejected closures.
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      if (weight_of_edge[k] < 0) continue;
+      const bool rejected = r2[k] > cbar2;
+      summary.rejected_edges += rejected ? 1 : 0;
+      weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
+          new ceres::ScaledLoss(nullptr, rejected ? 1e-12 : 1.0, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
+    }
+    ceres::Solver::Summary final_summary;
+    ceres::Solve(solver, &problem, &final_summary);
+    summary.iterations += static_cast<int>(final_summary.iterations.size()) - 1;
+  }
+  summary.solve_seconds = Seconds(start) - summary.init_seconds;
+  for (size_t v = 0; v < n; ++v) graph.poses()[v] = BlockToPose(&blocks[7 * v]);
+  summary.sesync_cost = SeSyncCost(graph);
+  summary.geodesic_chi2 = GeodesicChi2(graph);
+  return summary;
+}
+
+}  // namespace cairn
