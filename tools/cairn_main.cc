@@ -13,6 +13,8 @@ namespace {
 constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
+    {"sim", "simulate a multi-robot mission into EuRoC/ASL folders and CAN logs", RunSim},
+    {"bench sim", "time rendering a stereo pair of the simulator's default world", RunBenchSim},
 });
 
 void PrintHelp() {
