@@ -144,6 +144,13 @@ void Terrain::BuildMaxMipmap() {
     mip_width_.push_back(nw);
     w = nw;
   }
+  flat_mip_.clear();
+  mip_offset_.clear();
+  for (const auto& m : mip_) {
+    mip_offset_.push_back(flat_mip_.size());
+    flat_mip_.insert(flat_mip_.end(), m.begin(), m.end());
+  }
+  mip_.clear();
 }
 
 void Terrain::BuildAlbedo(const WorldOptions& o, const std::vector<Eigen::Vector4d>& rocks) {
@@ -172,6 +179,10 @@ void Terrain::BuildAlbedo(const WorldOptions& o, const std::vector<Eigen::Vector
         if (dx * dx + dy * dy < r[2] * r[2]) a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n_) + static_cast<size_t>(ix)] *= 0.75f;
       }
     }
+  }
+  grain_.resize(256 * 256);
+  for (size_t i = 0; i < grain_.size(); ++i) {
+    grain_[i] = static_cast<float>(LatticeValue(seed_, static_cast<int64_t>(i & 255), static_cast<int64_t>(i >> 8), 9));
   }
   albedo_.resize(a.size());
   for (size_t i = 0; i < a.size(); ++i) {
@@ -209,14 +220,21 @@ float Terrain::Albedo(double x, double y) const {
   const float top = albedo_[i] + (albedo_[i + 1] - albedo_[i]) * u;
   const float bottom = albedo_[i + s] + (albedo_[i + s + 1] - albedo_[i + s]) * u;
   const float base = (top + (bottom - top) * v) * (1.0f / 255.0f);
-  // Sub-texel grain (about 6 mm) so that close-range stereo still has texture.
-  const float grain = static_cast<float>(ValueNoise(seed_, x * 160.0, y * 160.0, 9));
+  // Sub-texel grain (about 6 mm) so that close-range stereo still has texture: a seeded 256 x 256
+  // tile of lattice values, bilinearly interpolated (a hash per lookup would cost as much as the
+  // ray cast).
+  const double qx = (x + half_size_) * 160.0, qy = (y + half_size_) * 160.0;
+  const int gx0 = static_cast<int>(qx), gy0 = static_cast<int>(qy);
+  const float fu = static_cast<float>(qx - gx0), fv = static_cast<float>(qy - gy0);
+  auto g = [&](int a, int b) { return grain_[static_cast<size_t>(((b & 255) << 8) | (a & 255))]; };
+  const float g0 = g(gx0, gy0) + (g(gx0 + 1, gy0) - g(gx0, gy0)) * fu;
+  const float g1 = g(gx0, gy0 + 1) + (g(gx0 + 1, gy0 + 1) - g(gx0, gy0 + 1)) * fu;
+  const float grain = g0 + (g1 - g0) * fv;
   return std::clamp(base * (1.0f + 0.12f * grain), 0.0f, 1.0f);
 }
 
 size_t Terrain::memory_bytes() const {
-  size_t bytes = h_.size() * sizeof(float) + albedo_.size();
-  for (const auto& m : mip_) bytes += m.size() * sizeof(float);
+  size_t bytes = h_.size() * sizeof(float) + albedo_.size() + flat_mip_.size() * sizeof(float);
   return bytes;
 }
 
@@ -227,8 +245,9 @@ TerrainHit Terrain::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d
   // Grid coordinates: x, y in cells, z in metres; t stays the distance along the unit ray.
   const double ox = (origin.x() + half_size_) / res_, oy = (origin.y() + half_size_) / res_, oz = origin.z();
   const double dx = dir.x() / res_, dy = dir.y() / res_, dz = dir.z();
-  const int top = static_cast<int>(mip_.size()) - 1;
-  if (dz >= 0.0 && oz > mip_[top][0]) return miss;
+  const int top = static_cast<int>(mip_width_.size()) - 1;
+  const double top_height = flat_mip_.back();
+  if (dz >= 0.0 && oz > top_height) return miss;
   double t0 = 1e-6, t1 = t_max;
   // Clip to the grid's footprint and to the slab below the highest point.
   const double inf = std::numeric_limits<double>::infinity();
@@ -242,29 +261,31 @@ TerrainHit Terrain::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
   }
-  if (dz < 0.0) t0 = std::max(t0, (mip_[top][0] - oz) / dz);
-  else if (dz > 0.0) t1 = std::min(t1, (mip_[top][0] - oz) / dz);
+  if (dz < 0.0) t0 = std::max(t0, (top_height - oz) / dz);
+  else if (dz > 0.0) t1 = std::min(t1, (top_height - oz) / dz);
   if (t0 >= t1) return miss;
 
   double t = t0;
-  int ix = std::clamp(static_cast<int>(std::floor(ox + t * dx)), 0, cells - 1);
-  int iy = std::clamp(static_cast<int>(std::floor(oy + t * dy)), 0, cells - 1);
-  int level = top;
+  // Grid coordinates are non-negative here, so truncation is floor (and avoids a libm call).
+  int ix = std::clamp(static_cast<int>(ox + t * dx), 0, cells - 1);
+  int iy = std::clamp(static_cast<int>(oy + t * dy), 0, cells - 1);
+  // Starting below the root saves descents; rays rarely clear nodes larger than this.
+  int level = std::min(top, kStartLevel);
   const double inv_dx = dx != 0.0 ? 1.0 / dx : inf, inv_dy = dy != 0.0 ? 1.0 / dy : inf;
   for (int guard = 0; guard < 1 << 20; ++guard) {
     const int cx = ix >> level, cy = iy >> level, s = 1 << level;
     const double tx = dx > 0 ? ((cx + 1) * s - ox) * inv_dx : dx < 0 ? (cx * s - ox) * inv_dx : inf;
     const double ty = dy > 0 ? ((cy + 1) * s - oy) * inv_dy : dy < 0 ? (cy * s - oy) * inv_dy : inf;
     const double t_exit = std::min({tx, ty, t1});
-    const float hmax = mip_[static_cast<size_t>(level)][static_cast<size_t>(cy) * static_cast<size_t>(mip_width_[static_cast<size_t>(level)]) + static_cast<size_t>(cx)];
+    const float hmax = flat_mip_[mip_offset_[static_cast<size_t>(level)] + static_cast<size_t>(cy) * static_cast<size_t>(mip_width_[static_cast<size_t>(level)]) + static_cast<size_t>(cx)];
     const double z0 = oz + t * dz, z1 = oz + t_exit * dz;
     bool below = std::min(z0, z1) <= hmax;
     if (below && level > 0) {
       // Skip to where the ray drops to the node's maximum, then look at the children.
       if (z0 > hmax) {
         t = (hmax - oz) / dz;
-        ix = std::clamp(static_cast<int>(std::floor(ox + t * dx)), cx * s, std::min(cells, (cx + 1) * s) - 1);
-        iy = std::clamp(static_cast<int>(std::floor(oy + t * dy)), cy * s, std::min(cells, (cy + 1) * s) - 1);
+        ix = std::clamp(static_cast<int>(ox + t * dx), cx * s, std::min(cells, (cx + 1) * s) - 1);
+        iy = std::clamp(static_cast<int>(oy + t * dy), cy * s, std::min(cells, (cy + 1) * s) - 1);
       }
       --level;
       continue;
@@ -295,10 +316,10 @@ TerrainHit Terrain::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d
     t = t_exit;
     if (tx <= ty) {
       ix = dx > 0 ? (cx + 1) * s : cx * s - 1;
-      iy = std::clamp(static_cast<int>(std::floor(oy + t * dy)), cy * s, (cy + 1) * s - 1);
+      iy = std::clamp(static_cast<int>(oy + t * dy), cy * s, (cy + 1) * s - 1);
     } else {
       iy = dy > 0 ? (cy + 1) * s : cy * s - 1;
-      ix = std::clamp(static_cast<int>(std::floor(ox + t * dx)), cx * s, (cx + 1) * s - 1);
+      ix = std::clamp(static_cast<int>(ox + t * dx), cx * s, (cx + 1) * s - 1);
     }
     if (ix < 0 || iy < 0 || ix >= cells || iy >= cells) {
       if (tx <= ty) return miss;  // left the grid through an x edge
@@ -306,7 +327,7 @@ TerrainHit Terrain::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d
     }
     ix = std::clamp(ix, 0, cells - 1);
     iy = std::clamp(iy, 0, cells - 1);
-    if (level < top) ++level;
+    if (level < kStartLevel && level < top) ++level;
   }
   return miss;
 }

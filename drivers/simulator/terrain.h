@@ -32,7 +32,7 @@ class Terrain {
   // First hit of the ray origin + t * dir (dir unit length) with t in (0, t_max].
   TerrainHit Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max) const;
   size_t memory_bytes() const;
-  double max_height() const { return mip_.back()[0]; }
+  double max_height() const { return flat_mip_.back(); }
 
  private:
   float H(int ix, int iy) const { return h_[static_cast<size_t>(iy) * static_cast<size_t>(n_) + static_cast<size_t>(ix)]; }
@@ -44,8 +44,12 @@ class Terrain {
   int n_ = 0;       // vertices per side; cells per side is n_ - 1
   uint64_t seed_ = 0;
   std::vector<float> h_;
-  std::vector<std::vector<float>> mip_;  // level 0: per-cell maxima; last level: 1 x 1
+  std::vector<std::vector<float>> mip_;  // while building: level 0 per-cell maxima .. 1 x 1
   std::vector<int> mip_width_;
+  std::vector<float> flat_mip_;        // all levels, level k at mip_offset_[k]
+  std::vector<size_t> mip_offset_;
+  std::vector<float> grain_;           // 256 x 256 tile of fine albedo detail in [-1, 1]
+  static constexpr int kStartLevel = 4;
   int tex_n_ = 0;
   double tex_res_ = 0.0;
   std::vector<uint8_t> albedo_;
