@@ -135,17 +135,28 @@ Status MissionSimulator::Write(const std::string& dir, const std::function<void(
   return Status::Ok();
 }
 
+std::vector<ImuTruth> MissionSimulator::ImuStream(size_t r) const {
+  ImuSynthesizer imu(robots_[r].imu, SimRandom::Mix(static_cast<uint64_t>(world_.seed) ^ (0x1A0 + r)));
+  return imu.Generate(robots_[r].trajectory, mission_.start, mission_.duration);
+}
+
+WheelCanStream MissionSimulator::WheelStream(size_t r) const {
+  const SimRobot& robot = robots_[r];
+  if (robot.wheels.empty()) return {};
+  WheelCanEncoder encoder(mission_.can, robot.wheels.front().z(),
+                          SimRandom::Mix(static_cast<uint64_t>(world_.seed) ^ (0xCA0 + r)));
+  return encoder.Generate(robot.trajectory, mission_.start, mission_.duration, mission_.can_rate_hz);
+}
+
 Status MissionSimulator::WriteRobot(size_t r, const std::string& dir,
                                     const std::function<void(double)>& progress, size_t frames_before,
                                     size_t frames_total) const {
   const SimRobot& robot = robots_[r];
-  const uint64_t seed = static_cast<uint64_t>(world_.seed);
   auto writer = EurocWriter::Create(dir, robot.stereo, robot.camera_rate_hz, robot.imu);
   if (!writer.ok()) return writer.status();
   CAIRN_RETURN_IF_ERROR(WriteMarkers(dir + "/markers.csv", robot.markers));
 
-  ImuSynthesizer imu(robot.imu, SimRandom::Mix(seed ^ (0x1A0 + r)));
-  const std::vector<ImuTruth> samples = imu.Generate(robot.trajectory, mission_.start, mission_.duration);
+  const std::vector<ImuTruth> samples = ImuStream(r);
   for (const ImuTruth& s : samples) CAIRN_RETURN_IF_ERROR((*writer)->AddImu(s));
 
   // Cameras are triggered on IMU sample instants (hardware synchronization).
@@ -163,9 +174,7 @@ Status MissionSimulator::WriteRobot(size_t r, const std::string& dir,
   CAIRN_RETURN_IF_ERROR((*writer)->Close());
 
   if (robot.kind == SimRobotKind::kRover) {
-    WheelCanEncoder encoder(mission_.can, robot.wheels.front().z(), SimRandom::Mix(seed ^ (0xCA0 + r)));
-    const WheelCanStream stream = encoder.Generate(robot.trajectory, mission_.start, mission_.duration,
-                                                   mission_.can_rate_hz);
+    const WheelCanStream stream = WheelStream(r);
     const std::string path = dir + "/can0.log";
     FILE* f = std::fopen(path.c_str(), "w");
     if (f == nullptr) return IoError(path + ": cannot create");

@@ -14,8 +14,10 @@
 
 #include "drivers/can_wheel_options.h"
 #include "drivers/simulator/camera_renderer.h"
+#include "drivers/simulator/imu_synthesizer.h"
 #include "drivers/simulator/sim_robot.h"
 #include "drivers/simulator/terrain.h"
+#include "drivers/simulator/wheel_can_encoder.h"
 #include "drivers/simulator/world_options.h"
 #include "hal/status.h"
 
@@ -27,6 +29,7 @@ struct MissionOptions {
   double duration = 10.0;         // s
   double image_scale = 1.0;       // < 1 shrinks every camera (tests)
   double can_rate_hz = 100.0;
+  double exposure_time = 0.004;   // s, reported with every stereo frame
   Timestamp start = Timestamp::FromNanoseconds(int64_t{1700000000} * 1000000000);
   RenderOptions render;
   CanWheelOptions can;            // frame layout of the rovers' platform controllers
@@ -45,6 +48,14 @@ class MissionSimulator {
   // Every robot's and the lander's geometry at mission time t (seconds from the start).
   RenderScene SceneAt(double t) const;
   Eigen::Vector3d sun_direction() const;
+
+  Timestamp start() const { return mission_.start; }
+  double duration() const { return mission_.duration; }
+  double exposure_time() const { return mission_.exposure_time; }
+  const CanWheelOptions& can_layout() const { return mission_.can; }
+  // Robot `r`'s IMU readings with ground truth, and (rovers) its wheel CAN traffic.
+  std::vector<ImuTruth> ImuStream(size_t r) const;
+  WheelCanStream WheelStream(size_t r) const;
 
   // Renders both images of robot `r` at mission time t.
   void RenderStereo(size_t r, double t, uint64_t frame, std::vector<uint8_t>* left,
