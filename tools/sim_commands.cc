@@ -22,7 +22,9 @@ namespace {
 
 constexpr const char* kSimUsage =
     "usage: cairn sim [--world WORLD.yaml] [--robots rover,hexacopter] [--duration SECONDS]\n"
-    "                 [--seed N] [--rover-config FILE] [--image-scale S] --out DIR\n"
+    "                 [--seed N] [--rover-config FILE] [--image-scale S] [--motion-blur N]\n"
+    "                 --out DIR\n"
+    "  --motion-blur:  average N instants over each exposure (default 1: off)\n"
     "  --rover-config: cairnd profile whose 'can:' section gives the wheel CAN layout\n"
     "                  (default configs/rover.yaml, else /etc/cairn/rover.yaml)\n";
 
@@ -107,6 +109,8 @@ int RunSim(const CommandArgs& args) {
       mission.robots = SplitComma(value);
     } else if (a == "--duration" && has_value && ParseDouble(value, &number)) {
       mission.duration = number;
+    } else if (a == "--motion-blur" && has_value && ParseDouble(value, &number) && number >= 1 && number <= 64) {
+      mission.motion_blur_samples = static_cast<int>(number);
     } else if (a == "--image-scale" && has_value && ParseDouble(value, &number) && number > 0.01 && number <= 1.0) {
       mission.image_scale = number;
     } else if (a == "--seed" && has_value && ParseDouble(value, &number) && number >= 0 && number < 9e15 &&

@@ -82,9 +82,41 @@ void CameraRenderer::Render(const RenderScene& scene, const PinholeRadTan& k,
                             const Eigen::Isometry3d& T_world_cam, const RenderOptions& options,
                             uint64_t noise_seed, std::vector<uint8_t>* image,
                             std::vector<float>* depth) {
+  std::vector<float> signal;
+  RenderSignal(scene, k, T_world_cam, options, &signal, depth);
+  ApplyNoise(signal, k.width, options, noise_seed, image);
+}
+
+void CameraRenderer::ApplyNoise(const std::vector<float>& signal, int width, const RenderOptions& options,
+                                uint64_t noise_seed, std::vector<uint8_t>* image) {
+  const auto& gauss = GaussTable();
+  image->resize(signal.size());
+  const size_t w = static_cast<size_t>(width);
+  for (size_t row = 0; row * w < signal.size(); ++row) {
+    SimRandom rng = SimRandom::Stream(noise_seed, row);
+    uint64_t bits = 0;
+    int bits_left = 0;
+    for (size_t i = row * w; i < (row + 1) * w; ++i) {
+      if (bits_left < 12) {
+        bits = rng.Next();
+        bits_left = 64;
+      }
+      const float g = gauss[bits & 4095];
+      bits >>= 12;
+      bits_left -= 12;
+      const double sigma = std::sqrt(options.read_noise * options.read_noise + options.shot_noise * signal[i]);
+      const double value = std::clamp(signal[i] + sigma * g, 0.0, 255.0);
+      (*image)[i] = static_cast<uint8_t>(value + 0.5);
+    }
+  }
+}
+
+void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan& k,
+                                  const Eigen::Isometry3d& T_world_cam, const RenderOptions& options,
+                                  std::vector<float>* out, std::vector<float>* depth) {
   const int w = k.width, h = k.height;
-  image->assign(static_cast<size_t>(w) * static_cast<size_t>(h), 0);
-  if (depth != nullptr) depth->assign(image->size(), 0.0f);
+  out->assign(static_cast<size_t>(w) * static_cast<size_t>(h), 0.0f);
+  if (depth != nullptr) depth->assign(out->size(), 0.0f);
   const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
 
   // Objects with the pixel rectangle their bounding sphere can cover.
@@ -117,14 +149,10 @@ void CameraRenderer::Render(const RenderScene& scene, const PinholeRadTan& k,
     add(m.T_body_marker, Eigen::Vector3d(m.size * 0.625, m.size * 0.625, 0.0), true, &m, 0.0f);
   }
 
-  const auto& gauss = GaussTable();
   const double scale = options.gain * options.exposure * 255.0;
   const Eigen::Matrix3d R = T_world_cam.linear();
   const Eigen::Vector3d origin = T_world_cam.translation();
   for (int v = 0; v < h; ++v) {
-    SimRandom rng = SimRandom::Stream(noise_seed, static_cast<uint64_t>(v));
-    uint64_t bits = 0;
-    int bits_left = 0;
     for (int u = 0; u < w; ++u) {
       const Eigen::Vector3d ray_cam = Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0).normalized();
       const Eigen::Vector3d dir = R * ray_cam;
@@ -168,15 +196,7 @@ void CameraRenderer::Render(const RenderScene& scene, const PinholeRadTan& k,
         signal = scale * albedo * (options.ambient + std::max(0.0, normal.dot(scene.sun_direction)));
         if (depth != nullptr) (*depth)[i] = static_cast<float>(t_best * ray_cam.z());
       }
-      if (bits_left < 12) {
-        bits = rng.Next();
-        bits_left = 64;
-      }
-      const float g = gauss[bits & 4095];
-      bits >>= 12;
-      bits_left -= 12;
-      const double sigma = std::sqrt(options.read_noise * options.read_noise + options.shot_noise * signal);
-      (*image)[i] = static_cast<uint8_t>(std::clamp(std::lround(signal + sigma * g), 0l, 255l));
+      (*out)[i] = static_cast<float>(signal);
     }
   }
 }

@@ -41,6 +41,13 @@ class CameraRenderer {
   static void Render(const RenderScene& scene, const PinholeRadTan& camera,
                      const Eigen::Isometry3d& T_world_cam, const RenderOptions& options,
                      uint64_t noise_seed, std::vector<uint8_t>* image, std::vector<float>* depth);
+  // The two halves of Render, so that motion blur can average noise-free signals over the
+  // exposure before the sensor adds its noise once.
+  static void RenderSignal(const RenderScene& scene, const PinholeRadTan& camera,
+                           const Eigen::Isometry3d& T_world_cam, const RenderOptions& options,
+                           std::vector<float>* signal, std::vector<float>* depth);
+  static void ApplyNoise(const std::vector<float>& signal, int width, const RenderOptions& options,
+                         uint64_t noise_seed, std::vector<uint8_t>* image);
 };
 
 }  // namespace cairn::sim

@@ -1,5 +1,6 @@
 #include "drivers/simulator/mission_simulator.h"
 
+#include <algorithm>
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
@@ -43,6 +44,9 @@ MissionSimulator::MissionSimulator(const WorldOptions& world, const MissionOptio
 Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const WorldOptions& world,
                                                                      const MissionOptions& mission) {
   if (mission.robots.empty()) return InvalidArgumentError("--robots: name at least one robot");
+  if (mission.motion_blur_samples < 1 || mission.motion_blur_samples > 64) {
+    return InvalidArgumentError("--motion-blur: samples per exposure must be in [1, 64]");
+  }
   if (!(mission.duration > 0.0) || mission.duration > 3600.0) {
     return InvalidArgumentError("--duration: must be in (0, 3600] s");
   }
@@ -104,15 +108,34 @@ RenderScene MissionSimulator::SceneAt(double t) const {
 void MissionSimulator::RenderStereo(size_t r, double t, uint64_t frame, std::vector<uint8_t>* left,
                                     std::vector<uint8_t>* right, std::vector<float>* left_depth) const {
   const SimRobot& robot = robots_[r];
-  const RenderScene scene = SceneAt(t);
-  const Eigen::Isometry3d T_world_body = robot.trajectory.Evaluate(t).T_world_body;
   const uint64_t seed = static_cast<uint64_t>(world_.seed);
-  CameraRenderer::Render(scene, robot.stereo.left.intrinsics, T_world_body * robot.stereo.left.T_body_cam,
-                         mission_.render, SimRandom::Mix(seed ^ SimRandom::Mix(r * 1000003 + frame * 2)),
-                         left, left_depth);
-  CameraRenderer::Render(scene, robot.stereo.right.intrinsics, T_world_body * robot.stereo.right.T_body_cam,
-                         mission_.render, SimRandom::Mix(seed ^ SimRandom::Mix(r * 1000003 + frame * 2 + 1)),
-                         right, nullptr);
+  const int samples = std::max(1, mission_.motion_blur_samples);
+  const CameraCalibration* cams[2] = {&robot.stereo.left, &robot.stereo.right};
+  std::vector<uint8_t>* images[2] = {left, right};
+  std::vector<float> sum[2], signal;
+  for (int i = 0; i < samples; ++i) {
+    // Instants spread evenly over the exposure, centred on the frame time (mid-exposure).
+    const double ti = samples == 1 ? t : t + mission_.exposure_time * ((i + 0.5) / samples - 0.5);
+    const RenderScene scene = SceneAt(ti);
+    const Eigen::Isometry3d T_world_body = robot.trajectory.Evaluate(ti).T_world_body;
+    for (int c = 0; c < 2; ++c) {
+      CameraRenderer::RenderSignal(scene, cams[c]->intrinsics, T_world_body * cams[c]->T_body_cam,
+                                   mission_.render, &signal, c == 0 && i == samples / 2 ? left_depth : nullptr);
+      if (i == 0) {
+        sum[c] = signal;
+      } else {
+        for (size_t p = 0; p < signal.size(); ++p) sum[c][p] += signal[p];
+      }
+    }
+  }
+  for (int c = 0; c < 2; ++c) {
+    if (samples > 1) {
+      for (float& v : sum[c]) v /= static_cast<float>(samples);
+    }
+    CameraRenderer::ApplyNoise(sum[c], cams[c]->intrinsics.width, mission_.render,
+                               SimRandom::Mix(seed ^ SimRandom::Mix(r * 1000003 + frame * 2 + static_cast<uint64_t>(c))),
+                               images[c]);
+  }
 }
 
 Status MissionSimulator::Write(const std::string& dir, const std::function<void(double)>& progress) const {

@@ -30,6 +30,8 @@ struct MissionOptions {
   double image_scale = 1.0;       // < 1 shrinks every camera (tests)
   double can_rate_hz = 100.0;
   double exposure_time = 0.004;   // s, reported with every stereo frame
+  // > 1: each image averages this many instants spread over the exposure (motion blur).
+  int motion_blur_samples = 1;
   Timestamp start = Timestamp::FromNanoseconds(int64_t{1700000000} * 1000000000);
   RenderOptions render;
   CanWheelOptions can;            // frame layout of the rovers' platform controllers

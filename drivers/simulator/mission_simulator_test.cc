@@ -110,6 +110,31 @@ TEST(MissionSimulatorTest, RobotsSeeEachOther) {
   EXPECT_EQ(scene.boxes.size(), 2u + 1u + 1u);
 }
 
+// Motion blur averages the exposure: the image changes and loses high-frequency energy.
+TEST(MissionSimulatorTest, MotionBlurSmoothsTheImage) {
+  MissionOptions m = ShortMission();
+  m.robots = {"hexacopter"};
+  m.image_scale = 0.2;
+  m.render.read_noise = 0.0;
+  m.render.shot_noise = 0.0;
+  auto sharp = MissionSimulator::Create(SmallWorld(3), m);
+  m.motion_blur_samples = 7;
+  m.exposure_time = 0.08;  // long exposure at 1 m/s: about 8 cm of travel
+  auto blurred = MissionSimulator::Create(SmallWorld(3), m);
+  ASSERT_TRUE(sharp.ok() && blurred.ok());
+  std::vector<uint8_t> a, b, unused;
+  (*sharp)->RenderStereo(0, 0.3, 3, &a, &unused);
+  (*blurred)->RenderStereo(0, 0.3, 3, &b, &unused);
+  ASSERT_EQ(a.size(), b.size());
+  auto energy = [](const std::vector<uint8_t>& img) {
+    double e = 0.0;
+    for (size_t i = 1; i < img.size(); ++i) e += std::abs(int(img[i]) - int(img[i - 1]));
+    return e;
+  };
+  EXPECT_NE(a, b);
+  EXPECT_LT(energy(b), 0.97 * energy(a));
+}
+
 TEST(MissionSimulatorTest, RejectsUnknownAndDuplicateRobots) {
   MissionOptions m = ShortMission();
   m.robots = {"rover", "submarine"};

@@ -61,3 +61,15 @@ TEST(WorldFileTest, InvalidWorldsAreRejectedNamingFileLineAndKey) {
 
 }  // namespace
 }  // namespace cairn::sim
+
+namespace cairn::sim {
+namespace {
+
+TEST(WorldFileTest, ShippedDefaultWorldIsTheBuiltInDefault) {
+  auto w = LoadWorldFile(testing::SourceDir() + "/configs/sim_world.yaml");
+  ASSERT_TRUE(w.ok()) << w.status().ToString();
+  EXPECT_EQ(WorldFileText(*w), WorldFileText(WorldOptions{}));
+}
+
+}  // namespace
+}  // namespace cairn::sim
