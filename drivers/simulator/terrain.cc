@@ -327,7 +327,10 @@ TerrainHit Terrain::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d
     }
     ix = std::clamp(ix, 0, cells - 1);
     iy = std::clamp(iy, 0, cells - 1);
-    if (level < kStartLevel && level < top) ++level;
+    // Climb only into a new parent: re-testing the parent just left would descend again at once.
+    if (level < kStartLevel && level < top && ((ix >> (level + 1)) != (cx >> 1) || (iy >> (level + 1)) != (cy >> 1))) {
+      ++level;
+    }
   }
   return miss;
 }
