@@ -20,7 +20,7 @@ Image ToImage(const cv::Mat& mat) {
 }  // namespace
 
 EurocReplay::EurocReplay(EurocDataset dataset, ReplayOptions options)
-    : dataset_(std::move(dataset)), options_(std::move(options)) {}
+    : dataset_(std::move(dataset)), options_(std::move(options)), pacer_(options_) {}
 
 EurocReplay::~EurocReplay() { Stop(); }
 
@@ -34,19 +34,8 @@ Status EurocReplay::Start(SensorSink* sink) {
 void EurocReplay::Stop() {
   if (!thread_.joinable()) return;
   thread_.request_stop();
-  wait_cv_.notify_all();
+  pacer_.Wake();
   thread_.join();
-}
-
-bool EurocReplay::WaitUntilDue(std::stop_token& stop, Timestamp t) {
-  if (stop.stop_requested()) return false;
-  if (options_.pacing == ReplayPacing::kFastAsPossible) return true;
-  const double speed = options_.pacing == ReplayPacing::kScaled ? options_.speed : 1.0;
-  const auto due = wall_start_ + std::chrono::nanoseconds(static_cast<int64_t>(
-                                     static_cast<double>((t - data_start_).nanoseconds()) / speed));
-  std::unique_lock lock(wait_mutex_);
-  wait_cv_.wait_until(lock, stop, due, [] { return false; });
-  return !stop.stop_requested();
 }
 
 bool EurocReplay::PublishStereo(const EurocStereoEntry& entry, uint64_t counter) {
@@ -75,14 +64,14 @@ void EurocReplay::Run(std::stop_token stop) {
   const auto& imu = dataset_.imu();
   const auto& stereo = dataset_.stereo();
   size_t i = 0, s = 0;
-  data_start_ = Timestamp::Max();
-  if (!imu.empty()) data_start_ = imu.front().time;
-  if (!stereo.empty()) data_start_ = std::min(data_start_, stereo.front().time);
-  wall_start_ = std::chrono::steady_clock::now();
+  Timestamp data_start = Timestamp::Max();
+  if (!imu.empty()) data_start = imu.front().time;
+  if (!stereo.empty()) data_start = std::min(data_start, stereo.front().time);
+  pacer_.Start(data_start);
   while (i < imu.size() || s < stereo.size()) {
     const bool take_imu = s >= stereo.size() || (i < imu.size() && imu[i].time <= stereo[s].time);
     const Timestamp t = take_imu ? imu[i].time : stereo[s].time;
-    if (!WaitUntilDue(stop, t)) return;  // stopped: not finished
+    if (!pacer_.WaitUntilDue(stop, t)) return;  // stopped: not finished
     if (take_imu) {
       sink_->OnImu(imu[i++]);
       published_imu_.fetch_add(1, std::memory_order_relaxed);

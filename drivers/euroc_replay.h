@@ -4,12 +4,11 @@
 // before the image arrives), paced in real time, scaled, or as fast as the pipeline takes them.
 
 #include <atomic>
-#include <condition_variable>
-#include <mutex>
 #include <thread>
 
 #include "drivers/euroc_dataset.h"
 #include "drivers/replay_options.h"
+#include "drivers/replay_pacer.h"
 #include "hal/sensor_source_interface.h"
 
 namespace cairn {
@@ -32,20 +31,15 @@ class EurocReplay final : public SensorSourceInterface {
  private:
   void Run(std::stop_token stop);
   bool PublishStereo(const EurocStereoEntry& entry, uint64_t counter);
-  // Sleeps until data time `t` is due; false when stopped meanwhile.
-  bool WaitUntilDue(std::stop_token& stop, Timestamp t);
 
   EurocDataset dataset_;
   ReplayOptions options_;
   SensorSink* sink_ = nullptr;
   std::jthread thread_;
-  std::mutex wait_mutex_;
-  std::condition_variable_any wait_cv_;
+  ReplayPacer pacer_;
   std::atomic<bool> finished_{false};
   std::atomic<size_t> published_imu_{0};
   std::atomic<size_t> published_stereo_{0};
-  std::chrono::steady_clock::time_point wall_start_;
-  Timestamp data_start_;
 };
 
 }  // namespace cairn

@@ -25,7 +25,7 @@ Image ToImage(std::vector<uint8_t>&& pixels, int width, int height) {
 
 SimulatorSource::SimulatorSource(std::shared_ptr<const MissionSimulator> simulator, size_t robot,
                                  ReplayOptions pacing)
-    : simulator_(std::move(simulator)), robot_(robot), pacing_(std::move(pacing)) {}
+    : simulator_(std::move(simulator)), robot_(robot), pacer_(pacing) {}
 
 SimulatorSource::~SimulatorSource() { Stop(); }
 
@@ -33,7 +33,7 @@ Status SimulatorSource::Start(SensorSink* sink) {
   if (thread_.joinable()) return FailedPreconditionError(name() + ": already started");
   if (robot_ >= simulator_->robots().size()) return InvalidArgumentError("simulator: no robot " + std::to_string(robot_));
   sink_ = sink;
-  wall_start_ = std::chrono::steady_clock::now();
+  pacer_.Start(simulator_->start());
   thread_ = std::jthread([this](std::stop_token stop) { Run(stop); });
   return Status::Ok();
 }
@@ -41,19 +41,8 @@ Status SimulatorSource::Start(SensorSink* sink) {
 void SimulatorSource::Stop() {
   if (!thread_.joinable()) return;
   thread_.request_stop();
-  wait_cv_.notify_all();
+  pacer_.Wake();
   thread_.join();
-}
-
-bool SimulatorSource::WaitUntilDue(std::stop_token& stop, Timestamp t) {
-  if (stop.stop_requested()) return false;
-  if (pacing_.pacing == ReplayPacing::kFastAsPossible) return true;
-  const double speed = pacing_.pacing == ReplayPacing::kScaled ? pacing_.speed : 1.0;
-  const auto due = wall_start_ + std::chrono::nanoseconds(static_cast<int64_t>(
-                                     static_cast<double>((t - simulator_->start()).nanoseconds()) / speed));
-  std::unique_lock lock(wait_mutex_);
-  wait_cv_.wait_until(lock, stop, due, [] { return false; });
-  return !stop.stop_requested();
 }
 
 void SimulatorSource::Run(std::stop_token stop) {
@@ -73,10 +62,10 @@ void SimulatorSource::Run(std::stop_token stop) {
     const Timestamp tc = c < can.frames.size() ? can.frames[c].time : Timestamp::Max();
     const Timestamp tf = f < frames ? start + Duration::Nanoseconds(static_cast<int64_t>(f) * period_ns) : Timestamp::Max();
     if (ti <= tc && ti <= tf) {
-      if ((stopped = !WaitUntilDue(stop, ti))) break;
+      if ((stopped = !pacer_.WaitUntilDue(stop, ti))) break;
       sink_->OnImu(imu[i++].sample);
     } else if (tc <= tf) {
-      if ((stopped = !WaitUntilDue(stop, tc))) break;
+      if ((stopped = !pacer_.WaitUntilDue(stop, tc))) break;
       WheelOdometrySample s;
       if (decoder.Feed(can.frames[c].frame, tc, &s) == CanWheelDecoder::Result::kSampleReady) {
         sink_->OnWheelOdometry(s);
@@ -85,7 +74,7 @@ void SimulatorSource::Run(std::stop_token stop) {
     } else {
       std::vector<uint8_t> left, right;
       simulator_->RenderStereo(robot_, static_cast<double>((tf - start).nanoseconds()) * 1e-9, f, &left, &right);
-      if ((stopped = !WaitUntilDue(stop, tf))) break;
+      if ((stopped = !pacer_.WaitUntilDue(stop, tf))) break;
       const PinholeRadTan& k = robot.stereo.left.intrinsics;
       StereoFrame frame;
       frame.time = tf;

@@ -5,12 +5,11 @@
 // scaled, or as fast as the sink takes them. Images are rendered when they fall due.
 
 #include <atomic>
-#include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <thread>
 
 #include "drivers/replay_options.h"
+#include "drivers/replay_pacer.h"
 #include "drivers/simulator/mission_simulator.h"
 #include "hal/sensor_source_interface.h"
 
@@ -29,17 +28,13 @@ class SimulatorSource final : public SensorSourceInterface {
 
  private:
   void Run(std::stop_token stop);
-  bool WaitUntilDue(std::stop_token& stop, Timestamp t);
 
   std::shared_ptr<const MissionSimulator> simulator_;
   size_t robot_;
-  ReplayOptions pacing_;
+  ReplayPacer pacer_;
   SensorSink* sink_ = nullptr;
   std::jthread thread_;
-  std::mutex wait_mutex_;
-  std::condition_variable_any wait_cv_;
   std::atomic<bool> finished_{false};
-  std::chrono::steady_clock::time_point wall_start_;
 };
 
 }  // namespace cairn::sim
