@@ -23,6 +23,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"graph replay", "feed a g2o graph vertex by vertex into the online SLAM graph, time each update", RunGraphReplay},
     {"graph inject", "add random false loop closures to a g2o graph (robustness tests)", RunGraphInject},
     {"bench graph", "online SLAM graph on thesis-sized multi-robot graphs: update and covariance times", RunBenchGraph},
+    {"sim", "simulate a multi-robot mission into EuRoC/ASL folders and CAN logs", RunSim},
+    {"bench sim", "time rendering a stereo pair of the simulator's default world", RunBenchSim},
 });
 
 void PrintHelp() {

@@ -21,5 +21,7 @@ int RunGraphSolve(const CommandArgs& args);
 int RunGraphReplay(const CommandArgs& args);
 int RunGraphInject(const CommandArgs& args);
 int RunBenchGraph(const CommandArgs& args);
+int RunSim(const CommandArgs& args);
+int RunBenchSim(const CommandArgs& args);
 
 }  // namespace cairn::tools
