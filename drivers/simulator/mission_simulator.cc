@@ -11,6 +11,7 @@
 #include "drivers/simulator/euroc_writer.h"
 #include "drivers/simulator/imu_synthesizer.h"
 #include "drivers/simulator/sim_random.h"
+#include "drivers/simulator/tag36h11_code.h"
 #include "drivers/simulator/wheel_can_encoder.h"
 
 namespace cairn::sim {
@@ -44,6 +45,8 @@ MissionSimulator::MissionSimulator(const WorldOptions& world, const MissionOptio
 Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const WorldOptions& world,
                                                                      const MissionOptions& mission) {
   if (mission.robots.empty()) return InvalidArgumentError("--robots: name at least one robot");
+  // Robot i carries tags 10 i .. 10 i + 2; the lander's tags are 200 .. 203.
+  if (mission.robots.size() > 20) return InvalidArgumentError("--robots: at most 20 robots per mission");
   if (mission.motion_blur_samples < 1 || mission.motion_blur_samples > 64) {
     return InvalidArgumentError("--motion-blur: samples per exposure must be in [1, 64]");
   }
@@ -77,7 +80,7 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
       SimMarker m;
       m.id = 200 + k;
       m.size = 2.0 * tag;
-      m.bits = PlaceholderMarkerBits(m.id);
+      m.bits = *Tag36h11MarkerBits(m.id);
       const double az = kPi / 2 * k;
       m.T_body_marker.linear() = (Eigen::AngleAxisd(az, Eigen::Vector3d::UnitZ()) *
                                   Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitY()) *

@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "drivers/simulator/sim_random.h"
+#include "drivers/simulator/tag36h11_code.h"
 
 namespace cairn::sim {
 namespace {
@@ -60,10 +61,6 @@ std::vector<Eigen::Vector3d> UnwrapYaw(std::vector<Eigen::Vector3d> e) {
 
 }  // namespace
 
-uint64_t PlaceholderMarkerBits(int id) {
-  return SimRandom::Mix(0x7A6D11ull + static_cast<uint64_t>(id)) & ((uint64_t{1} << 36) - 1);
-}
-
 SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
                    double duration, double image_scale, double tag_size) {
   SimRobot r;
@@ -110,7 +107,7 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
     SimMarker m;
     m.id = 10 * index + k;
     m.size = tag_size;
-    m.bits = PlaceholderMarkerBits(m.id);
+    m.bits = *Tag36h11MarkerBits(m.id);
     const double az = kPi + 2 * kPi * k / 3;  // first tag faces backwards
     const Eigen::Matrix3d R_face =
         (Eigen::AngleAxisd(az, Eigen::Vector3d::UnitZ()) *
@@ -158,7 +155,7 @@ SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int ind
   SimMarker m;
   m.id = 100 + index;
   m.size = tag_size;
-  m.bits = PlaceholderMarkerBits(m.id);
+  m.bits = *Tag36h11MarkerBits(m.id);
   m.T_body_marker.linear() = Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitX()).toRotationMatrix();  // faces down
   m.T_body_marker.translation() = Eigen::Vector3d(0, 0, -0.065);
   r.markers.push_back(m);

@@ -19,7 +19,7 @@ enum class SimRobotKind { kRover, kHexacopter };
 // A square fiducial: 10 x 10 modules (white quiet ring, black border ring, 6 x 6 data bits),
 // `size` is the edge of the black border square. z of the marker frame points out of the face.
 struct SimMarker {
-  int id = 0;
+  int id = 0;  // tag36h11 id
   double size = 0.16;
   uint64_t bits = 0;  // 36 data bits, row-major from the marker's top-left
   Eigen::Isometry3d T_body_marker = Eigen::Isometry3d::Identity();
@@ -43,10 +43,6 @@ struct SimRobot {
   // Wheel contact points in the body frame (rover only).
   std::vector<Eigen::Vector3d> wheels;
 };
-
-// Placeholder marker code: a seeded 36-bit pattern per id. These are NOT the published tag36h11
-// code words, so a real AprilTag detector will not decode them (see the simulator README note).
-uint64_t PlaceholderMarkerBits(int id);
 
 // LRU-like rover (1024 x 508, f = 1080 px, b = 0.09 m; MTi-10 IMU) driving a seeded loop.
 // `image_scale` shrinks the cameras (tests); `index` separates robots of one mission.
