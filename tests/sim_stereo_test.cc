@@ -1,0 +1,78 @@
+// The stereo kernel on the simulator's rendered pairs: SGM recovers the ray-cast ground-truth
+// disparity. This ties the simulator's camera model (rectified pinhole pair, baseline along x) to
+// the matcher's conventions, so a sign or offset error in either shows up here.
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "drivers/simulator/mission_simulator.h"
+#include "fpga/sgm_matcher.h"
+
+namespace cairn {
+namespace {
+
+struct Agreement {
+  size_t compared = 0;      // SGM-valid pixels with ground truth
+  size_t within_1px = 0;
+  size_t ground_truth = 0;  // pixels with ground truth at all
+};
+
+Agreement CompareFrame(const sim::MissionSimulator& sim, size_t robot, double t, StereoMatcher& matcher) {
+  const StereoCalibration& calib = sim.robots()[robot].stereo;
+  const PinholeRadTan& cam = calib.left.intrinsics;
+  std::vector<uint8_t> left, right;
+  std::vector<float> depth;
+  sim.RenderStereo(robot, t, 0, &left, &right, &depth);
+  const double baseline = calib.baseline();
+  StereoMatcherInput in{left.data(), right.data(), cam.width, cam.height, cam.width, cam.fx, baseline, 0.0};
+  StereoMatcherOutput out;
+  EXPECT_TRUE(matcher.Match(in, &out).ok());
+  Agreement a;
+  for (int y = 0; y < cam.height; ++y) {
+    for (int x = 0; x < cam.width; ++x) {
+      const float z = depth[static_cast<size_t>(y) * cam.width + x];
+      if (!(z > 0.0f)) continue;
+      ++a.ground_truth;
+      const int16_t d = out.disparity_at(x, y);
+      if (d == kInvalidDisparity) continue;
+      ++a.compared;
+      const double truth = cam.fx * baseline / z;
+      if (std::abs(d / static_cast<double>(kDisparityScale) - truth) <= 1.0) ++a.within_1px;
+    }
+  }
+  return a;
+}
+
+TEST(SimStereoTest, SgmRecoversRenderedDisparityWithinOnePixel) {
+  sim::WorldOptions world;
+  sim::MissionOptions mission;
+  mission.robots = {"rover", "hexacopter"};
+  mission.duration = 20.0;
+  auto sim = sim::MissionSimulator::Create(world, mission);
+  ASSERT_TRUE(sim.ok()) << sim.status().ToString();
+  SgmOptions options;  // the shipped defaults: 128 disparities, 5x5 census, 4 paths
+  auto matcher = SgmMatcher::Create(options);
+  ASSERT_TRUE(matcher.ok()) << matcher.status().ToString();
+  for (size_t r = 0; r < (*sim)->robots().size(); ++r) {
+    for (const double t : {3.0, 14.0}) {
+      const Agreement a = CompareFrame(**sim, r, t, **matcher);
+      SCOPED_TRACE((*sim)->robots()[r].name + " at t = " + std::to_string(t) + " s");
+      ASSERT_GT(a.ground_truth, 0u);
+      std::printf("%s t=%.0f s: %.2f %% within 1 px, %.2f %% of the ground-truth pixels valid\n",
+                  (*sim)->robots()[r].name.c_str(), t, 100.0 * a.within_1px / a.compared,
+                  100.0 * a.compared / a.ground_truth);
+      // The bound: within 1 px on 95 % of the valid pixels.
+      EXPECT_GE(static_cast<double>(a.within_1px), 0.95 * static_cast<double>(a.compared))
+          << a.within_1px << " of " << a.compared;
+      // And the matcher must not buy that by invalidating most of the image.
+      EXPECT_GE(static_cast<double>(a.compared), 0.6 * static_cast<double>(a.ground_truth))
+          << a.compared << " valid of " << a.ground_truth;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace cairn
