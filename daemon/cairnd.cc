@@ -11,6 +11,7 @@
 #include "daemon/options_yaml_writer.h"
 #include "daemon/pipeline.h"
 #include "daemon/run_summary.h"
+#include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "drivers/euroc_replay.h"
 #include "drivers/mcap_replay.h"
@@ -66,9 +67,24 @@ Status Cairnd::Prepare() {
       return DataLossError(options_.replay.dataset + ": the dataset holds no IMU samples and no stereo pairs");
     }
     dataset_ = *ds;
+    stereo_calibration_ = ds->stereo_calibration();
+    imu_calibration_ = ds->imu_calibration();
+    camera_rate_hz_ = ds->camera_rate_hz();
     sources_.push_back(std::make_unique<EurocReplay>(*ds, options_.replay));
   }
-  if (options_.can.enabled) sources_.push_back(std::make_unique<SocketCanWheelDriver>(options_.can));
+  if (options_.source == SourceKind::kSim) {
+    auto robot = OpenSimulatedRobot(options_, config_path_);
+    if (!robot.ok()) return robot.status();
+    stereo_calibration_ = robot->stereo;
+    imu_calibration_ = robot->imu;
+    camera_rate_hz_ = robot->camera_rate_hz;
+    ground_truth_ = std::move(robot->ground_truth);
+    sources_.push_back(std::move(robot->source));
+  }
+  // A simulated robot's wheels come from the simulator (through the same CAN decoder).
+  if (options_.can.enabled && options_.source != SourceKind::kSim) {
+    sources_.push_back(std::make_unique<SocketCanWheelDriver>(options_.can));
+  }
   if (sources_.empty()) {
     return InvalidArgumentError(config_path_ +
                                 ": no sensor source is enabled (this build has replay and SocketCAN "
@@ -85,7 +101,7 @@ int Cairnd::Run() {
   const auto wall_start = std::chrono::steady_clock::now();
   RunInfo run;
   run.robot = options_.robot.name;
-  run.mode = options_.source == SourceKind::kReplay ? "replay" : "live";
+  run.mode = options_.source == SourceKind::kReplay ? "replay" : options_.source == SourceKind::kSim ? "sim" : "live";
 
   const ExecutorsOptions& ex = options_.executors;
   if (ex.estimation.realtime || ex.stereo.realtime || ex.telemetry.realtime) {
@@ -93,11 +109,10 @@ int Cairnd::Run() {
   }
 
   PipelineRates rates;
-  if (dataset_) {
-    rates.imu_hz = dataset_->imu_calibration().rate_hz;
-    rates.camera_hz = dataset_->camera_rate_hz();
-  }
-  const bool deterministic = options_.source == SourceKind::kReplay && options_.replay.deterministic;
+  if (imu_calibration_) rates.imu_hz = imu_calibration_->rate_hz;
+  rates.camera_hz = camera_rate_hz_;
+  // Replayed and simulated sources share the replay section's pacing.
+  const bool deterministic = options_.source != SourceKind::kLive && options_.replay.deterministic;
   Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
   std::unique_ptr<TelemetryStage> telemetry;
   if (options_.recording.enabled || options_.live.enabled) {
@@ -141,7 +156,7 @@ int Cairnd::Run() {
   spdlog::info("cairnd '{}' running ({}{})", run.robot, run.mode,
                deterministic ? ", deterministic" : "");
 
-  const bool finite = options_.source == SourceKind::kReplay;
+  const bool finite = options_.source != SourceKind::kLive;  // replays and simulations end
   sigset_t set;
   sigemptyset(&set);
   sigaddset(&set, SIGTERM);
@@ -212,6 +227,10 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
                                                                       config_path_ + ")\n" +
                                                                       OptionsYamlWriter::Write(options_)));
   CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/diagnostics.json", BuildDiagnosticsJson(run, pipeline)));
+  if (ground_truth_) {
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/ground_truth.tum",
+                                              TrajectoryIo::Format(*ground_truth_, TrajectoryFormat::kTum)));
+  }
   // Last: its presence means the run's outputs are complete.
   return WriteFileAtomically(dir + "/summary.json", BuildSummaryJson(run, pipeline));
 }

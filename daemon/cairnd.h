@@ -9,6 +9,8 @@
 
 #include "daemon/cairnd_options.h"
 #include "drivers/euroc_dataset.h"
+#include "estimation/trajectory.h"
+#include "hal/calibration.h"
 #include "hal/sensor_source_interface.h"
 
 namespace cairn {
@@ -31,6 +33,12 @@ class Cairnd {
   CairndOptions options_;
   std::string config_path_;
   std::optional<EurocDataset> dataset_;
+  // The sensors' calibration where the source knows it (replayed datasets, the simulator).
+  std::optional<StereoCalibration> stereo_calibration_;
+  std::optional<ImuCalibration> imu_calibration_;
+  double camera_rate_hz_ = 0.0;
+  // Simulated runs: the robot's true trajectory, written as ground_truth.tum for evaluation.
+  std::optional<Trajectory> ground_truth_;
   std::vector<std::unique_ptr<SensorSourceInterface>> sources_;
 };
 

@@ -1,5 +1,5 @@
 // cairnd: the onboard SLAM daemon.
-//   cairnd --config FILE [--set key=value ...] [--replay DATASET_DIR] [--out DIR] [--log-level L]
+//   cairnd --config FILE [--set key=value ...] [--replay DATASET_DIR | --sim] [--out DIR] [--log-level L]
 
 #include <cstdio>
 #include <cstdlib>
@@ -18,8 +18,10 @@ namespace {
 
 void Usage(FILE* f) {
   std::fprintf(f,
-               "usage: cairnd --config FILE [--set key.path=value ...] [--replay DATASET_DIR]\n"
-               "              [--out DIR] [--log-level trace|debug|info|warn|error]\n");
+               "usage: cairnd --config FILE [--set key.path=value ...] [--replay DATASET_DIR | --sim]\n"
+               "              [--out DIR] [--log-level trace|debug|info|warn|error]\n"
+               "  --replay DIR  replay an EuRoC/ASL folder or a cairnd MCAP recording\n"
+               "  --sim         play robot.name in the simulated mission of the config's sim section\n");
 }
 
 void SetupLogging(const std::string& level) {
@@ -46,6 +48,7 @@ std::string YamlQuote(const std::string& s) {
 
 int main(int argc, char** argv) {
   std::string config, replay, out, level = "info";
+  bool simulate = false;
   std::vector<std::string> overrides;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -59,6 +62,7 @@ int main(int argc, char** argv) {
     if (a == "--config") config = value("--config");
     else if (a == "--set") overrides.emplace_back(value("--set"));
     else if (a == "--replay") replay = value("--replay");
+    else if (a == "--sim") simulate = true;
     else if (a == "--out") out = value("--out");
     else if (a == "--log-level") level = value("--log-level");
     else if (a == "--help" || a == "-h") { Usage(stdout); return 0; }
@@ -77,7 +81,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cairnd: unknown log level '%s'\n", level.c_str());
     return 2;
   }
-  // --replay and --out are shorthands for the matching --set overrides.
+  if (simulate && !replay.empty()) {
+    std::fprintf(stderr, "cairnd: --replay and --sim exclude each other\n");
+    return 2;
+  }
+  // --replay, --sim and --out are shorthands for the matching --set overrides.
+  if (simulate) overrides.push_back("source=sim");
   if (!replay.empty()) {
     overrides.push_back("source=replay");
     overrides.push_back("replay.dataset=" + YamlQuote(replay));

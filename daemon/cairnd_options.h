@@ -8,6 +8,7 @@
 #include "daemon/executor_options.h"
 #include "daemon/live_stream_options.h"
 #include "daemon/recording_options.h"
+#include "daemon/sim_source_options.h"
 #include "drivers/can_wheel_options.h"
 #include "drivers/replay_options.h"
 #include "hal/options_visitor.h"
@@ -15,7 +16,7 @@
 namespace cairn {
 
 enum class RobotKind { kRover, kHexacopter, kHandheld };
-enum class SourceKind { kReplay, kLive };
+enum class SourceKind { kReplay, kLive, kSim };
 
 struct RobotOptions {
   std::string name = "robot";
@@ -59,6 +60,7 @@ struct CairndOptions {
   RobotOptions robot;
   SourceKind source = SourceKind::kReplay;
   ReplayOptions replay;
+  SimSourceOptions sim;
   CanWheelOptions can;
   ExecutorsOptions executors;
   QueueOptions queues;
@@ -69,8 +71,10 @@ struct CairndOptions {
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
-    v.Choice("source", source, {{"replay", SourceKind::kReplay}, {"live", SourceKind::kLive}});
+    v.Choice("source", source,
+             {{"replay", SourceKind::kReplay}, {"live", SourceKind::kLive}, {"sim", SourceKind::kSim}});
     v.Section("replay", replay);
+    v.Section("sim", sim);
     v.Section("can", can);
     v.Section("executors", executors);
     v.Section("queues", queues);

@@ -13,6 +13,7 @@ namespace {
 constexpr auto kCommands = std::to_array<Command>({
     {"config check", "load a cairnd config (and --set overrides) and report every error", RunConfigCheck},
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
+    {"summary", "a short account of cairnd output folders (from their summary.json)", RunSummary},
     {"mcap info", "summarize MCAP recordings (also ones cut short by a crash)", RunMcapInfo},
     {"trajectory convert", "convert trajectories between TUM, EuRoC CSV and KITTI", RunTrajectoryConvert},
     {"stereo", "dense disparity of a stereo pair (SGM), written as PFM", RunStereo},

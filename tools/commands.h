@@ -7,6 +7,7 @@ namespace cairn::tools {
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
 int RunMcapInfo(const CommandArgs& args);
+int RunSummary(const CommandArgs& args);
 int RunTrajectoryConvert(const CommandArgs& args);
 
 }  // namespace cairn::tools

@@ -1,0 +1,68 @@
+#include "daemon/simulated_robot.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "drivers/simulator/mission_simulator.h"
+#include "drivers/simulator/simulator_source.h"
+#include "drivers/simulator/world_file.h"
+
+namespace cairn {
+namespace {
+
+std::vector<std::string> SplitRobots(const std::string& list) {
+  std::vector<std::string> names;
+  std::stringstream in(list);
+  for (std::string name; std::getline(in, name, ',');) {
+    name.erase(0, name.find_first_not_of(' '));
+    name.erase(name.find_last_not_of(' ') + 1);
+    names.push_back(name);
+  }
+  return names;
+}
+
+}  // namespace
+
+Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path) {
+  const SimSourceOptions& o = options.sim;
+  sim::WorldOptions world;
+  if (!o.world.empty()) {
+    auto loaded = sim::LoadWorldFile(o.world);
+    if (!loaded.ok()) return Status(loaded.status().code(), config_path + ": sim.world: " + loaded.status().message());
+    world = *loaded;
+  }
+  world.seed = static_cast<uint64_t>(o.seed);
+
+  sim::MissionOptions mission;
+  mission.robots = SplitRobots(o.robots);
+  mission.duration = o.duration;
+  mission.image_scale = o.image_scale;
+  mission.motion_blur_samples = static_cast<int>(o.motion_blur_samples);
+  // The simulated platform controller speaks the layout this robot's decoder expects.
+  mission.can = options.can;
+  const auto it = std::find(mission.robots.begin(), mission.robots.end(), options.robot.name);
+  if (it == mission.robots.end()) {
+    return InvalidArgumentError(config_path + ": robot.name '" + options.robot.name +
+                                "' is not one of sim.robots '" + o.robots + "'");
+  }
+  const size_t index = static_cast<size_t>(it - mission.robots.begin());
+  auto simulator = sim::MissionSimulator::Create(world, mission);
+  if (!simulator.ok()) {
+    return Status(simulator.status().code(), config_path + ": sim: " + simulator.status().message());
+  }
+  std::shared_ptr<const sim::MissionSimulator> shared = std::move(*simulator);
+
+  SimulatedRobot robot;
+  const sim::SimRobot& r = shared->robots()[index];
+  robot.stereo = r.stereo;
+  robot.imu = r.imu;
+  robot.camera_rate_hz = r.camera_rate_hz;
+  robot.ground_truth.frame = "world";
+  for (const sim::ImuTruth& s : shared->ImuStream(index)) {
+    robot.ground_truth.poses.push_back({s.sample.time, s.state.T_world_body});
+  }
+  robot.source = std::make_unique<sim::SimulatorSource>(shared, index, options.replay);
+  return robot;
+}
+
+}  // namespace cairn

@@ -1,0 +1,26 @@
+#pragma once
+// `source: sim`: builds the simulated mission a configuration describes and the sensor source of
+// the robot this daemon plays, with its true calibration and ground-truth trajectory.
+
+#include <memory>
+#include <string>
+
+#include "daemon/cairnd_options.h"
+#include "estimation/trajectory.h"
+#include "hal/calibration.h"
+#include "hal/sensor_source_interface.h"
+
+namespace cairn {
+
+struct SimulatedRobot {
+  std::unique_ptr<SensorSourceInterface> source;
+  StereoCalibration stereo;
+  ImuCalibration imu;
+  double camera_rate_hz = 0.0;
+  Trajectory ground_truth;  // T_world_body at every IMU sample, frame "world"
+};
+
+// Errors name `config_path` and the offending key (sim.world, sim.robots, robot.name).
+Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path);
+
+}  // namespace cairn

@@ -1,0 +1,91 @@
+// cairnd with `source: sim`: the rover of a simulated two-robot mission, end to end through the
+// daemon as a user runs it (`cairnd --config configs/rover.yaml --sim`), and the errors a wrong
+// simulation setup gives before anything runs.
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "estimation/trajectory.h"
+#include "tests/support/json_value.h"
+#include "tests/support/process_runner.h"
+#include "tests/support/test_data.h"
+
+namespace cairn {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::JsonValue;
+using testing::RunProcess;
+
+std::string Cairnd() { return testing::BinaryDir() + "/daemon/cairnd"; }
+std::string Config(const std::string& robot) { return testing::SourceDir() + "/configs/" + robot + ".yaml"; }
+
+// Small images and a short mission keep the test fast (and affordable under the sanitizers).
+std::vector<std::string> SimArgs(const std::string& robot, const std::string& out) {
+  return {Cairnd(), "--config", Config(robot), "--sim", "--out", out,
+          "--set", "sim.duration=2", "--set", "sim.image_scale=0.25",
+          "--set", "replay.pacing=fast", "--set", "replay.deterministic=true",
+          "--set", "live.enabled=false", "--set", "recording.enabled=false"};
+}
+
+TEST(CairndSimTest, RoverPublishesEveryStreamAndWritesGroundTruth) {
+  const std::string out = testing::FreshTempDir("cairnd_sim");
+  const auto r = RunProcess(SimArgs("rover", out));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue s = JsonValue::ParseFile(out + "/summary.json");
+  EXPECT_EQ(s["mode"].string(), "sim");
+  EXPECT_EQ(s["stop_reason"].string(), "end_of_data");
+  // 2 s at 200 Hz IMU, 10 Hz cameras and 100 Hz wheel cycles, both ends included.
+  EXPECT_EQ(s["streams"]["imu"]["count"].number(), 401);
+  EXPECT_EQ(s["streams"]["stereo"]["count"].number(), 21);
+  EXPECT_GE(s["streams"]["wheel_odometry"]["count"].number(), 190);
+  EXPECT_EQ(s["streams"]["imu"]["gaps"].number(), 0);
+  EXPECT_EQ(s["stereo"]["width"].number(), 256);   // 1024 * 0.25
+  EXPECT_EQ(s["stereo"]["height"].number(), 127);  // 508 * 0.25
+  EXPECT_EQ(s["faults"]["total"].number(), 0);
+  auto truth = TrajectoryIo::Read(out + "/ground_truth.tum", TrajectoryFormat::kTum);
+  ASSERT_TRUE(truth.ok()) << truth.status().ToString();
+  EXPECT_EQ(truth->poses.size(), 401u);
+}
+
+TEST(CairndSimTest, HexacopterHasNoWheels) {
+  const std::string out = testing::FreshTempDir("cairnd_sim_hexa");
+  const auto r = RunProcess(SimArgs("hexacopter", out));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue s = JsonValue::ParseFile(out + "/summary.json");
+  EXPECT_EQ(s["streams"]["imu"]["count"].number(), 801);  // 400 Hz
+  EXPECT_EQ(s["streams"]["wheel_odometry"]["count"].number(), 0);
+}
+
+TEST(CairndSimTest, WrongSetupsAreRefusedNamingTheKey) {
+  const std::string out = testing::FreshTempDir("cairnd_sim_bad");
+  auto args = SimArgs("rover", out + "/a");
+  args.insert(args.end(), {"--set", "sim.robots=hexacopter"});
+  auto r = RunProcess(args);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("robot.name 'rover' is not one of sim.robots"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out + "/a/summary.json"));
+
+  args = SimArgs("rover", out + "/b");
+  args.insert(args.end(), {"--set", "sim.world=/nonexistent/world.yaml"});
+  r = RunProcess(args);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("sim.world"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/world.yaml"), std::string::npos) << r.output;
+
+  args = SimArgs("rover", out + "/c");
+  args.insert(args.end(), {"--set", "sim.robots=rover,submarine"});
+  r = RunProcess(args);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("submarine"), std::string::npos) << r.output;
+
+  r = RunProcess({Cairnd(), "--config", Config("rover"), "--sim", "--replay", "/tmp"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("exclude each other"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace cairn
