@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "daemon/image_encoding_options.h"
 #include "hal/options_visitor.h"
 
 namespace cairn {
@@ -13,6 +14,7 @@ struct LiveStreamOptions {
   std::string address = "127.0.0.1";
   int64_t port = 8765;        // 0 picks a free port (logged at start-up)
   int64_t image_every = 5;    // send every Nth stereo frame's images
+  ImageEncodingOptions images;
   int64_t client_queue = 256; // messages queued per client before the oldest are dropped
 
   void Visit(OptionsVisitor& v) {
@@ -20,6 +22,7 @@ struct LiveStreamOptions {
     v.Text("address", address);
     v.Integer("port", port, 0, 65535, "");
     v.Integer("image_every", image_every, 1, 1000, "frames");
+    v.Section("images", images);
     v.Integer("client_queue", client_queue, 1, 1 << 20, "messages");
   }
 };

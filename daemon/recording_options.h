@@ -1,5 +1,6 @@
 #pragma once
 
+#include "daemon/image_encoding_options.h"
 #include "drivers/mcap/chunk_codec.h"
 #include "hal/options_visitor.h"
 
@@ -12,6 +13,7 @@ struct RecordingOptions {
   McapCompression compression = McapCompression::kZstd;
   int64_t chunk_size = 4 << 20;
   int64_t rotate_size = int64_t{1} << 30;
+  ImageEncodingOptions images;
 
   void Visit(OptionsVisitor& v) {
     v.Flag("enabled", enabled);
@@ -20,6 +22,7 @@ struct RecordingOptions {
                                           {"lz4", McapCompression::kLz4}});
     v.Integer("chunk_size", chunk_size, 4096, int64_t{1} << 30, "bytes");
     v.Integer("rotate_size", rotate_size, int64_t{1} << 20, int64_t{1} << 40, "bytes");
+    v.Section("images", images);
   }
   Status Validate() const {
     return rotate_size > chunk_size ? Status::Ok()

@@ -2,7 +2,12 @@
 
 #include <algorithm>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "cairn/sensors.pb.h"
+#include "foxglove/CompressedImage.pb.h"
 #include "foxglove/RawImage.pb.h"
 
 namespace cairn {
@@ -26,6 +31,8 @@ const char* TelemetryTopicName(TelemetryTopic topic) {
     case TelemetryTopic::kStereoInfo: return "/stereo/info";
     case TelemetryTopic::kCam0Image: return "/cam0/image";
     case TelemetryTopic::kCam1Image: return "/cam1/image";
+    case TelemetryTopic::kCam0Compressed: return "/cam0/image/compressed";
+    case TelemetryTopic::kCam1Compressed: return "/cam1/image/compressed";
   }
   return "";
 }
@@ -37,6 +44,8 @@ const google::protobuf::Descriptor* TelemetryTopicDescriptor(TelemetryTopic topi
     case TelemetryTopic::kStereoInfo: return msg::StereoFrameInfo::descriptor();
     case TelemetryTopic::kCam0Image:
     case TelemetryTopic::kCam1Image: return foxglove::RawImage::descriptor();
+    case TelemetryTopic::kCam0Compressed:
+    case TelemetryTopic::kCam1Compressed: return foxglove::CompressedImage::descriptor();
   }
   return nullptr;
 }
@@ -95,6 +104,34 @@ const std::string& SampleEncoder::Image(const cairn::Image& img, Timestamp t, co
   }
   m.SerializeToString(&image_);
   return image_;
+}
+
+bool SampleEncoder::Compressed(const cairn::Image& img, Timestamp t, const char* frame_id,
+                               const ImageEncodingOptions& options, const std::string** encoded) {
+  if (img.empty()) return false;
+  const int type = img.format == PixelFormat::kGray8 ? CV_8UC1 : CV_8UC3;
+  cv::Mat view(img.height, img.width, type, const_cast<uint8_t*>(img.data.get()), static_cast<size_t>(img.stride));
+  cv::Mat bgr;
+  if (img.format == PixelFormat::kRgb8) cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);  // codecs take BGR
+  const cv::Mat& pixels = img.format == PixelFormat::kRgb8 ? bgr : view;
+  const bool jpeg = options.format == ImageFormat::kJpeg;
+  const std::vector<int> params =
+      jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, static_cast<int>(options.jpeg_quality)}
+           : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};  // fast: the telemetry core is shared
+  try {
+    if (!cv::imencode(jpeg ? ".jpg" : ".png", pixels, codec_buffer_, params)) return false;
+  } catch (const cv::Exception&) {
+    return false;
+  }
+  foxglove::CompressedImage m;
+  m.mutable_timestamp()->set_seconds(t.nanoseconds() / 1000000000);
+  m.mutable_timestamp()->set_nanos(static_cast<int32_t>(t.nanoseconds() % 1000000000));
+  m.set_frame_id(frame_id);
+  m.set_format(jpeg ? "jpeg" : "png");
+  m.set_data(codec_buffer_.data(), codec_buffer_.size());
+  m.SerializeToString(&compressed_);
+  *encoded = &compressed_;
+  return true;
 }
 
 }  // namespace cairn

@@ -21,6 +21,7 @@ TelemetryStage::~TelemetryStage() { StopAndDrain(); }
 
 void TelemetryStage::EnableRecording(std::string directory, const RecordingOptions& options) {
   recorder_ = std::make_unique<McapRecorder>(std::move(directory), options);
+  recording_images_ = options.images;
 }
 
 Status TelemetryStage::EnableLiveStream(const std::string& robot_name, const LiveStreamOptions& options) {
@@ -38,6 +39,7 @@ Status TelemetryStage::EnableLiveStream(const std::string& robot_name, const Liv
       R"({"type":"object","properties":{"status":{"type":"string"},"time_ns":{"type":"integer"}}})",
       "jsonschema"});
   image_every_ = options.image_every;
+  live_images_ = options.images;
   const Status s = live_->Start(options.address, static_cast<uint16_t>(options.port),
                                 static_cast<size_t>(options.client_queue));
   if (!s.ok()) live_.reset();
@@ -118,28 +120,49 @@ void TelemetryStage::Emit(TelemetryTopic topic, Timestamp time, const std::strin
   }
 }
 
+const std::string* TelemetryStage::EncodeImage(const Image& image, Timestamp time, const char* frame,
+                                               const ImageEncodingOptions& options) {
+  if (options.format == ImageFormat::kRaw) return &encoder_.Image(image, time, frame);
+  const std::string* encoded = nullptr;
+  if (encoder_.Compressed(image, time, frame, options, &encoded)) return encoded;
+  if (image_codec_failures_++ == 0) spdlog::error("telemetry: an image did not compress (further failures are only counted)");
+  return nullptr;
+}
+
 void TelemetryStage::HandleStereo(const StereoFrame& f) {
   Emit(TelemetryTopic::kStereoInfo, f.time, encoder_.StereoInfo(f));
-  const bool live_images = live_ && stereo_seen_ % static_cast<uint64_t>(image_every_) == 0 &&
-                           (live_->HasSubscribers(live_channel_[static_cast<int>(TelemetryTopic::kCam0Image)]) ||
-                            live_->HasSubscribers(live_channel_[static_cast<int>(TelemetryTopic::kCam1Image)]));
+  const bool live_turn = live_ && stereo_seen_ % static_cast<uint64_t>(image_every_) == 0;
   ++stereo_seen_;
-  if (!recorder_ && !live_images) return;  // images are the expensive part: encode only when needed
-  const struct { TelemetryTopic topic; const Image* image; const char* frame; } sides[] = {
-      {TelemetryTopic::kCam0Image, &f.left, "cam0"}, {TelemetryTopic::kCam1Image, &f.right, "cam1"}};
-  for (const auto& side : sides) {
-    const std::string& encoded = encoder_.Image(*side.image, f.time, side.frame);
+  const auto topic_of = [](bool left, ImageFormat format) {
+    if (format == ImageFormat::kRaw) return left ? TelemetryTopic::kCam0Image : TelemetryTopic::kCam1Image;
+    return left ? TelemetryTopic::kCam0Compressed : TelemetryTopic::kCam1Compressed;
+  };
+  for (const bool left : {true, false}) {
+    const Image& image = left ? f.left : f.right;
+    const char* frame = left ? "cam0" : "cam1";
+    // Images are the expensive part: encode only for a recorder or a subscribed client, and once
+    // when both want the same encoding.
+    const std::string* recorded = nullptr;
     if (recorder_) {
-      if (Status s = recorder_->Write(side.topic, f.time, encoded); !s.ok() && !error_logged_) {
-        spdlog::error("recording: {} (further errors are only counted)", s.ToString());
-        error_logged_ = true;
+      recorded = EncodeImage(image, f.time, frame, recording_images_);
+      if (recorded != nullptr) {
+        if (Status s = recorder_->Write(topic_of(left, recording_images_.format), f.time, *recorded);
+            !s.ok() && !error_logged_) {
+          spdlog::error("recording: {} (further errors are only counted)", s.ToString());
+          error_logged_ = true;
+        }
       }
     }
-    if (live_images) {
-      live_->Publish(live_channel_[static_cast<int>(side.topic)], f.time,
-                     {reinterpret_cast<const uint8_t*>(encoded.data()), encoded.size()});
-      live_published_.fetch_add(1, std::memory_order_relaxed);
-    }
+    if (!live_turn) continue;
+    const uint32_t channel = live_channel_[static_cast<int>(topic_of(left, live_images_.format))];
+    if (!live_->HasSubscribers(channel)) continue;
+    const bool same = recorded != nullptr && recording_images_.format == live_images_.format &&
+                      (live_images_.format != ImageFormat::kJpeg ||
+                       recording_images_.jpeg_quality == live_images_.jpeg_quality);
+    const std::string* sent = same ? recorded : EncodeImage(image, f.time, frame, live_images_);
+    if (sent == nullptr) continue;
+    live_->Publish(channel, f.time, {reinterpret_cast<const uint8_t*>(sent->data()), sent->size()});
+    live_published_.fetch_add(1, std::memory_order_relaxed);
   }
 }
 

@@ -61,6 +61,9 @@ class TelemetryStage {
   void Loop(std::stop_token stop);
   void Emit(TelemetryTopic topic, Timestamp time, const std::string& encoded);
   void HandleStereo(const StereoFrame& f);
+  // The encoded message (valid until the next encoding), or null when the codec failed.
+  const std::string* EncodeImage(const Image& image, Timestamp time, const char* frame,
+                                 const ImageEncodingOptions& options);
 
   const bool deterministic_;
   std::atomic<uint64_t> next_sequence_{0};
@@ -75,6 +78,9 @@ class TelemetryStage {
   uint32_t live_channel_[kTelemetryTopicCount] = {};
   uint32_t diagnostics_channel_ = 0;
   int64_t image_every_ = 1;
+  ImageEncodingOptions recording_images_;
+  ImageEncodingOptions live_images_;
+  uint64_t image_codec_failures_ = 0;
   uint64_t stereo_seen_ = 0;
   std::atomic<uint64_t> live_published_{0};
   Executor executor_;

@@ -4,8 +4,12 @@
 #include <filesystem>
 #include <memory>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include "cairn/sensors.pb.h"
 #include "drivers/mcap/mcap_reader.h"
+#include "foxglove/CompressedImage.pb.h"
 #include "foxglove/RawImage.pb.h"
 
 namespace cairn {
@@ -33,6 +37,34 @@ Expected<Image> ToImage(const foxglove::RawImage& m, const std::string& where) {
   img.height = static_cast<int>(m.height());
   img.stride = static_cast<int>(m.step());
   img.format = format;
+  return img;
+}
+
+Expected<Image> ToImage(const foxglove::CompressedImage& m, const std::string& where) {
+  if (m.format() != "jpeg" && m.format() != "png") {
+    return DataLossError(where + ": unsupported compressed image format '" + m.format() + "'");
+  }
+  cv::Mat decoded;
+  try {
+    const cv::Mat bytes(1, static_cast<int>(m.data().size()), CV_8UC1, const_cast<char*>(m.data().data()));
+    decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception&) {
+    decoded.release();
+  }
+  if (decoded.empty() || decoded.depth() != CV_8U || (decoded.channels() != 1 && decoded.channels() != 3)) {
+    return DataLossError(where + ": " + m.format() + " image does not decode to 8-bit gray or colour");
+  }
+  const int row_bytes = decoded.cols * decoded.channels();
+  auto holder = std::shared_ptr<uint8_t[]>(new uint8_t[static_cast<size_t>(row_bytes) * static_cast<size_t>(decoded.rows)]);
+  for (int y = 0; y < decoded.rows; ++y) {
+    std::copy(decoded.ptr<uint8_t>(y), decoded.ptr<uint8_t>(y) + row_bytes, holder.get() + static_cast<ptrdiff_t>(y) * row_bytes);
+  }
+  Image img;
+  img.data = holder;
+  img.width = decoded.cols;
+  img.height = decoded.rows;
+  img.stride = row_bytes;
+  img.format = decoded.channels() == 1 ? PixelFormat::kGray8 : PixelFormat::kBgr8;
   return img;
 }
 
@@ -103,6 +135,7 @@ void McapReplay::Run(std::stop_token stop) {
     msg::WheelOdometrySample wheel;
     msg::StereoFrameInfo info;
     foxglove::RawImage raw;
+    foxglove::CompressedImage compressed;
     const auto fault = [&](const std::string& detail) {
       sink_->OnDeviceFault(DeviceFault{pending.time, "replay/mcap", DeviceFaultKind::kCorruptSample, detail});
     };
@@ -145,14 +178,17 @@ void McapReplay::Run(std::stop_token stop) {
             pending.exposure = Duration::Nanoseconds(info.exposure_ns());
             pending.frame_counter = info.frame_counter();
             pending_parts = 1;
-          } else if ((c.topic == "/cam0/image" || c.topic == "/cam1/image") && parse(raw)) {
-            const bool left = c.topic == "/cam0/image";
+          } else if (c.topic == "/cam0/image" || c.topic == "/cam1/image" || c.topic == "/cam0/image/compressed" ||
+                     c.topic == "/cam1/image/compressed") {
+            const bool left = c.topic.starts_with("/cam0/");
+            const bool is_compressed = c.topic.ends_with("/compressed");
+            if (!(is_compressed ? parse(compressed) : parse(raw))) return;
             if (pending_parts != (left ? 1 : 2) || static_cast<int64_t>(m.log_time) != pending.time.nanoseconds()) {
               fault(where + ": image without its stereo pair info, dropped");
               pending_parts = 0;
               return;
             }
-            auto img = ToImage(raw, where);
+            auto img = is_compressed ? ToImage(compressed, where) : ToImage(raw, where);
             if (!img.ok()) {
               fault(img.status().message());
               pending_parts = 0;

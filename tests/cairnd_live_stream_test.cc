@@ -82,7 +82,8 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   const testing::JsonValue r = testing::JsonValue::Parse(client.output);
   EXPECT_EQ(r["serverInfo"].string(), "cairnd euroc-mav");
   EXPECT_TRUE(r["errors"].array().empty()) << client.output;
-  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image", "/cam1/image", "/diagnostics"}) {
+  // The shipped configuration streams images as JPEG (foxglove.CompressedImage).
+  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image/compressed", "/cam1/image/compressed", "/diagnostics"}) {
     const testing::JsonValue& c = r["channels"][topic];
     EXPECT_GT(c["count"].number(), 0) << topic;
     EXPECT_EQ(c["decodeErrors"].number(), 0) << topic;
@@ -91,8 +92,12 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   }
   // Real-time IMU at 200 Hz for about 4 s.
   EXPECT_GT(r["channels"]["/imu"]["count"].number(), 400);
-  EXPECT_EQ(r["channels"]["/cam0/image"]["lastImage"]["width"].number(), 752);
-  EXPECT_EQ(r["channels"]["/cam0/image"]["lastImage"]["bytes"].number(), 752 * 480);
+  const testing::JsonValue& image = r["channels"]["/cam0/image/compressed"]["lastImage"];
+  EXPECT_EQ(image["format"].string(), "jpeg");
+  EXPECT_EQ(image["width"].number(), 752);
+  EXPECT_EQ(image["height"].number(), 480);
+  EXPECT_LT(image["bytes"].number(), 752 * 480 / 3);
+  EXPECT_EQ(r["channels"]["/cam0/image"]["count"].number(), 0);  // advertised, not sent
   EXPECT_EQ(r["channels"]["/wheel_odometry"]["schema"].string(), "cairn.msg.WheelOdometrySample");
   const testing::JsonValue d = testing::JsonValue::ParseFile(out + "/diagnostics.json");
   EXPECT_EQ(d["live_stream"]["port"].number(), port);

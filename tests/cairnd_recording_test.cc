@@ -72,6 +72,34 @@ TEST_F(CairndRecordingTest, ReplayOfARecordingReproducesTheRunAndTheRecording) {
   EXPECT_EQ(Read(dir_ + "/a/recording-000.mcap"), Read(dir_ + "/b/recording-000.mcap"));
 }
 
+// PNG recordings are lossless: replaying one and recording raw gives the raw recording of the
+// original run byte for byte. JPEG recordings are a fraction of the size and replay whole.
+TEST_F(CairndRecordingTest, CompressedImagesReplayPngBitExactAndJpegSmall) {
+  ASSERT_EQ(RunCairnd(testing::EurocMicro(), dir_ + "/raw").exit_code, 0);
+  const auto png = RunCairnd(testing::EurocMicro(), dir_ + "/png", {"--set", "recording.images.format=png"});
+  ASSERT_EQ(png.exit_code, 0) << png.output;
+  const JsonValue p = JsonValue::ParseFile(dir_ + "/png/summary.json");
+  EXPECT_EQ(p["recording"]["messages"]["/cam0/image/compressed"].number(), 95);
+  EXPECT_EQ(p["recording"]["messages"]["/cam1/image/compressed"].number(), 95);
+  EXPECT_FALSE(p["recording"]["messages"].has("/cam0/image"));
+  const auto again = RunCairnd(dir_ + "/png/recording-000.mcap", dir_ + "/png-raw");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(Read(dir_ + "/raw/recording-000.mcap"), Read(dir_ + "/png-raw/recording-000.mcap"));
+
+  const auto jpeg = RunCairnd(testing::EurocMicro(), dir_ + "/jpeg",
+                              {"--set", "recording.images.format=jpeg", "--set", "recording.images.jpeg_quality=90"});
+  ASSERT_EQ(jpeg.exit_code, 0) << jpeg.output;
+  const auto raw_size = fs::file_size(dir_ + "/raw/recording-000.mcap");
+  const auto jpeg_size = fs::file_size(dir_ + "/jpeg/recording-000.mcap");
+  EXPECT_LT(jpeg_size * 3, raw_size) << jpeg_size << " vs " << raw_size;  // measured: 3.9x smaller
+  const auto replayed = RunCairnd(dir_ + "/jpeg/recording-000.mcap", dir_ + "/jpeg-replay");
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.output;
+  const JsonValue r = JsonValue::ParseFile(dir_ + "/jpeg-replay/summary.json");
+  EXPECT_EQ(r["streams"]["stereo"]["count"].number(), 95);
+  EXPECT_EQ(r["stereo"]["width"].number(), 752);
+  EXPECT_EQ(r["faults"]["total"].number(), 0);
+}
+
 TEST_F(CairndRecordingTest, RotationSplitsFilesAndAFolderReplaysWhole) {
   const auto r = RunCairnd(testing::EurocMicro(), dir_ + "/rot",
                      {"--set", "recording.rotate_size=8388608", "--set", "recording.chunk_size=1048576",

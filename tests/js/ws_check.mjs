@@ -58,6 +58,19 @@ client.on("advertise", (channels) => {
     }
   }
 });
+// Width and height from a JPEG's start-of-frame segment (null when the data is no JPEG).
+function jpegSize(d) {
+  if (d.length < 4 || d[0] !== 0xff || d[1] !== 0xd8) return { width: null, height: null };
+  for (let i = 2; i + 9 < d.length;) {
+    if (d[i] !== 0xff) return { width: null, height: null };
+    const marker = d[i + 1];
+    const length = (d[i + 2] << 8) | d[i + 3];
+    if (marker >= 0xc0 && marker <= 0xc3) return { height: (d[i + 5] << 8) | d[i + 6], width: (d[i + 7] << 8) | d[i + 8] };
+    i += 2 + length;
+  }
+  return { width: null, height: null };
+}
+
 client.on("message", ({ subscriptionId, data }) => {
   const s = subs.get(subscriptionId);
   if (!s) return;
@@ -68,6 +81,7 @@ client.on("message", ({ subscriptionId, data }) => {
     if (t !== null && r.last !== null && t <= BigInt(r.last)) r.increasing = false;
     if (t !== null) r.last = t.toString();
     if (s.ch.topic.endsWith("/image")) r.lastImage = { width: m.width, height: m.height, bytes: m.data.length, encoding: m.encoding };
+    if (s.ch.topic.endsWith("/image/compressed")) r.lastImage = { format: m.format, bytes: m.data.length, ...jpegSize(m.data) };
     r.count++;
   } catch (e) {
     r.decodeErrors++;
