@@ -38,7 +38,10 @@ struct DepthPointOptions {
 // Obstacle classification on one depth image (thesis 5.1.1).
 struct ObstacleOptions {
   double edge_jump = 0.2;        // m; depth jump between column neighbours that starts a slope test
-  double max_slope = 0.6;        // rise over run the robot can drive (eq. 5.1 threshold)
+  // ...plus this many eq. 5.2c depth errors of the near point, so stereo noise between adjacent
+  // rows (whose minimal slope is just the ray's declination) does not pass for a cliff.
+  double edge_jump_sigmas = 3.0;
+  double max_slope = 0.4;        // rise over run the robot can drive (eq. 5.1 threshold, ~22 deg)
   int64_t edge_max_gap_rows = 2; // invalid pixels bridged between column neighbours
   double edge_max_range = 12.0;  // m; the far point of an edge beyond this is placed at it
   double cell_size = 0.05;       // m; 2.5-D height grid
@@ -48,6 +51,7 @@ struct ObstacleOptions {
 
   void Visit(OptionsVisitor& v) {
     v.Number("edge_jump", edge_jump, 0.01, 10.0, "m");
+    v.Number("edge_jump_sigmas", edge_jump_sigmas, 0.0, 100.0, "");
     v.Number("max_slope", max_slope, 0.01, 100.0, "");
     v.Integer("edge_max_gap_rows", edge_max_gap_rows, 0, 16, "rows");
     v.Number("edge_max_range", edge_max_range, 0.5, 200.0, "m");

@@ -35,6 +35,8 @@ void ObstacleClassifier::FindNegativeEdges(const DepthImage& image, const Eigen:
   const float jump = static_cast<float>(options_.edge_jump);
   const int gap = static_cast<int>(options_.edge_max_gap_rows);
   const double far = options_.edge_max_range;
+  const float sigmas = static_cast<float>(options_.edge_jump_sigmas);
+  const float c = static_cast<float>(model_.DepthError(1.0));  // eq. 5.2c: c z^2
   const auto point = [&](int u, int v, double z) {
     return Eigen::Vector3d(T_local_cam * Eigen::Vector3d((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z));
   };
@@ -48,6 +50,7 @@ void ObstacleClassifier::FindNegativeEdges(const DepthImage& image, const Eigen:
       last_row_[static_cast<size_t>(u)] = v;
       last_depth_[static_cast<size_t>(u)] = z;
       if (above < 0 || v - above - 1 > gap || !(upper - z > jump) || !std::isfinite(z)) continue;
+      if (!(upper - z > jump + sigmas * c * z * z)) continue;
       const Eigen::Vector3d p = point(u, v, z);
       const Eigen::Vector3d q = point(u, above, std::min(static_cast<double>(upper), far));
       const double s = MinimalSlope(p, q);

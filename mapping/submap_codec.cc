@@ -194,13 +194,14 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   }
   const uint16_t version = h.U16();
   const uint8_t compression = h.U8();
-  h.U8();
+  const uint8_t reserved = h.U8();
   const uint64_t raw_size = h.U64();
   const uint64_t packed_size = h.U64();
   const uint32_t raw_crc = h.U32();
   const uint32_t packed_crc = h.U32();
   if (h.failed()) return DataLossError("submap header truncated");
   if (version != kVersion) return DataLossError("submap format version " + std::to_string(version) + " is not supported (expected " + std::to_string(kVersion) + ")");
+  if (reserved != 0) return DataLossError("submap header reserved byte is " + std::to_string(reserved));
   if (compression > static_cast<uint8_t>(McapCompression::kLz4)) return DataLossError("submap has unknown compression " + std::to_string(compression));
   if (raw_size > kMaxPayload) return DataLossError("submap payload size " + std::to_string(raw_size) + " is implausible");
   if (packed_size != h.remaining()) {
