@@ -90,9 +90,12 @@ void MapComposer::Contribute(const octomap::OcTree& tree, const std::vector<Clou
   const double res = tree.getResolution();
   const float inv = static_cast<float>(1.0 / res);
   const bool aligned = GridAligned(T, res);
+  // Gravity-aligned submaps differ by yaw only: voxel layers map onto layers, so 2 x 2 samples in
+  // x-y suffice; other rotations need 2 x 2 x 2.
+  const int samples = std::abs(T.linear()(2, 2) - 1.0) < 1e-9 ? 4 : 8;
   const Eigen::Vector3f offsets[8] = {
-      {-0.25f, -0.25f, -0.25f}, {0.25f, -0.25f, -0.25f}, {-0.25f, 0.25f, -0.25f}, {0.25f, 0.25f, -0.25f},
-      {-0.25f, -0.25f, 0.25f},  {0.25f, -0.25f, 0.25f},  {-0.25f, 0.25f, 0.25f},  {0.25f, 0.25f, 0.25f}};
+      {-0.25f, -0.25f, 0.0f},   {0.25f, -0.25f, 0.0f},   {-0.25f, 0.25f, 0.0f},   {0.25f, 0.25f, 0.0f},
+      {-0.25f, -0.25f, -0.25f}, {0.25f, -0.25f, -0.25f}, {-0.25f, 0.25f, -0.25f}, {0.25f, 0.25f, -0.25f}};
   resample_.Clear();
   const int tree_depth = static_cast<int>(tree.getTreeDepth());
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
@@ -116,7 +119,10 @@ void MapComposer::Contribute(const octomap::OcTree& tree, const std::vector<Clou
             }
             continue;
           }
-          for (const Eigen::Vector3f& off : offsets) {
+          for (int si = 0; si < samples; ++si) {
+            // The 8-sample set: the z = -1/4 layer above plus the same x-y pattern at z = +1/4.
+            Eigen::Vector3f off = offsets[si];
+            if (samples == 8 && si < 4) off.z() = 0.25f;
             if (!VoxelKey::Of(g + R * (off * static_cast<float>(res)), inv, &key)) continue;
             Occ& o = resample_[key];
             o.sum += value;

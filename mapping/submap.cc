@@ -24,10 +24,7 @@ OccupancyUpdateStats OpenSubmap::Integrate(const CameraPoints& pts, OccupancyInt
   if (metadata_.images == 0) metadata_.start = pts.time;
   metadata_.end = pts.time;
   ++metadata_.images;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const uint8_t g = pts.intensity[i];
-    cloud_.Add(pts.p_local[i], g, g, g, pts.obstacle[i] != 0);
-  }
+  cloud_.AddBatch(pts.p_local, pts.intensity, pts.obstacle);
   return integrator->Integrate(pts, tree_.get());
 }
 

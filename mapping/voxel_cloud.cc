@@ -31,6 +31,41 @@ bool VoxelCloud::Add(const Eigen::Vector3f& p, uint8_t r, uint8_t g, uint8_t b, 
   return true;
 }
 
+size_t VoxelCloud::AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
+                            const std::vector<uint8_t>& obstacle) {
+  size_t dropped = 0;
+  uint64_t run_key = VoxelKey::kEmpty;
+  Accum run;
+  Eigen::Vector3f corner = Eigen::Vector3f::Zero();
+  const auto flush = [&] {
+    if (run_key != VoxelKey::kEmpty) voxels_[run_key].Merge(run);
+  };
+  for (size_t i = 0; i < p.size(); ++i) {
+    uint64_t key;
+    if (!VoxelKey::Of(p[i], inv_res_, &key)) {
+      ++dropped;
+      continue;
+    }
+    if (key != run_key) {
+      flush();
+      run_key = key;
+      run = Accum{};
+      corner = VoxelKey::Unpack(key).cast<float>() * static_cast<float>(res_);
+    }
+    const Eigen::Vector3f d = p[i] - corner;
+    run.sx += d.x();
+    run.sy += d.y();
+    run.sz += d.z();
+    ++run.n;
+    run.sr += gray[i];
+    run.sg += gray[i];
+    run.sb += gray[i];
+    run.obstacles += obstacle[i] != 0;
+  }
+  flush();
+  return dropped;
+}
+
 CloudPoint VoxelCloud::Centroid(uint64_t key, const Accum& a) const {
   const float inv_n = 1.0f / static_cast<float>(a.n);
   const float res = static_cast<float>(res_);
