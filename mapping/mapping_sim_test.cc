@@ -9,11 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "drivers/simulator/camera_renderer.h"
-#include "drivers/simulator/terrain.h"
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
-#include "mapping/mapping_test_scenes.h"
+#include "mapping/sim_depth_scenes.h"
 
 namespace cairn {
 namespace {
@@ -30,30 +28,8 @@ sim::Terrain World() {
   return sim::Terrain::Generate(w);
 }
 
-// Rendered depth with 0.2 px disparity noise and 1/16 px quantization (sky: beyond range).
 DepthImage Render(const sim::Terrain& terrain, const StereoCamera& cam, const Eigen::Isometry3d& T_world_cam, unsigned seed) {
-  sim::RenderScene scene;
-  scene.terrain = &terrain;
-  std::vector<uint8_t> gray;
-  std::vector<float> depth;
-  sim::CameraRenderer::Render(scene, cam.intrinsics, T_world_cam, sim::RenderOptions{}, seed, &gray, &depth);
-  DepthImage img;
-  img.width = cam.intrinsics.width;
-  img.height = cam.intrinsics.height;
-  img.intensity = gray;
-  img.depth.resize(depth.size());
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, 0.2);
-  const double fb = cam.intrinsics.fx * cam.baseline;
-  for (size_t i = 0; i < depth.size(); ++i) {
-    if (depth[i] <= 0.0f) {
-      img.depth[i] = std::numeric_limits<float>::infinity();
-      continue;
-    }
-    const double d = std::round((fb / depth[i] + noise(rng)) * 16.0) / 16.0;
-    img.depth[i] = d > 0 ? static_cast<float>(fb / d) : std::numeric_limits<float>::infinity();
-  }
-  return img;
+  return testing::RenderSimulatedDepth(terrain, cam, T_world_cam, seed, 0.2);
 }
 
 Eigen::Isometry3d CameraAt(const sim::Terrain& t, double x, double y, double yaw) {

@@ -8,16 +8,14 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "daemon/atomic_file.h"
-#include "drivers/simulator/camera_renderer.h"
-#include "drivers/simulator/terrain.h"
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
 #include "mapping/map_exporter.h"
+#include "mapping/sim_depth_scenes.h"
 #include "mapping/submap_codec.h"
 #include "tools/commands.h"
 
@@ -149,47 +147,7 @@ int RunMap(const CommandArgs& args) {
   return 2;
 }
 
-namespace {
 
-struct NullRequester : FrameSwitchRequesterInterface {
-  void RequestFrameSwitch(const FrameSwitchRequest&) override {}
-};
-
-Eigen::Isometry3d RoverCameraPose(const sim::Terrain& t, double x, double y, double yaw) {
-  Eigen::Matrix3d base;
-  base.col(0) = -Eigen::Vector3d::UnitY();
-  base.col(1) = -Eigen::Vector3d::UnitZ();
-  base.col(2) = Eigen::Vector3d::UnitX();
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * base *
-               Eigen::AngleAxisd(-25.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  T.translation() = Eigen::Vector3d(x, y, t.Height(x, y) + 1.3);
-  return T;
-}
-
-DepthImage RenderDepth(const sim::Terrain& terrain, const StereoCamera& cam, const Eigen::Isometry3d& T, unsigned seed,
-                       double noise_px) {
-  sim::RenderScene scene;
-  scene.terrain = &terrain;
-  std::vector<uint8_t> gray;
-  std::vector<float> depth;
-  sim::CameraRenderer::Render(scene, cam.intrinsics, T, sim::RenderOptions{}, seed, &gray, &depth);
-  DepthImage img;
-  img.width = cam.intrinsics.width;
-  img.height = cam.intrinsics.height;
-  img.intensity = std::move(gray);
-  img.depth.resize(depth.size());
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> noise(0.0, noise_px);
-  const double fb = cam.intrinsics.fx * cam.baseline;
-  for (size_t i = 0; i < depth.size(); ++i) {
-    const double d = depth[i] > 0.0f ? std::round((fb / depth[i] + noise(rng)) * 16.0) / 16.0 : 0.0;
-    img.depth[i] = d > 0.0 ? static_cast<float>(fb / d) : INFINITY;
-  }
-  return img;
-}
-
-}  // namespace
 
 int RunBenchMap(const CommandArgs& args) {
   int images = 44;
@@ -213,16 +171,8 @@ int RunBenchMap(const CommandArgs& args) {
   }
   sim::WorldOptions world;
   const sim::Terrain terrain = sim::Terrain::Generate(world);
-  StereoCamera cam;
-  cam.intrinsics.width = 1024;
-  cam.intrinsics.height = 508;
-  cam.intrinsics.fx = cam.intrinsics.fy = 1080.0;
-  cam.intrinsics.cx = 511.5;
-  cam.intrinsics.cy = 253.5;
-  cam.baseline = 0.09;
+  const StereoCamera cam = testing::RoverCamera(1.0);
   MappingOptions o;
-  NullRequester req;
-  LocalMapper mapper(o, cam, "rover1", &req);
   DepthProjector projector(o.depth, cam);
   ObstacleClassifier classifier(o.obstacles, cam, projector.error_model(), projector.range());
   OccupancyIntegrator integrator(o.submap.octree_resolution, 10.0);
@@ -238,8 +188,8 @@ int RunBenchMap(const CommandArgs& args) {
   for (int i = 0; i < images; ++i) {
     const double s = 7.0 * i / (images - 1);
     const double x = -8.0 + s, y = 3.0 + std::sin(0.3 * s), yaw = std::atan(0.3 * std::cos(0.3 * s));
-    const Eigen::Isometry3d T = RoverCameraPose(terrain, x, y, yaw);
-    const DepthImage img = RenderDepth(terrain, cam, T, static_cast<unsigned>(i + 1), noise_px);
+    const Eigen::Isometry3d T = testing::ForwardCameraPose({x, y, terrain.Height(x, y) + 1.3}, yaw, 25.0 * M_PI / 180.0);
+    const DepthImage img = testing::RenderSimulatedDepth(terrain, cam, T, static_cast<unsigned>(i + 1), noise_px);
     const auto t0 = Clock::now();
     if (!projector.Project(img, T, &pts).ok()) return 1;
     const auto t1 = Clock::now();
