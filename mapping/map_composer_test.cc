@@ -1,7 +1,7 @@
 #include "mapping/map_composer.h"
 
 #include <cmath>
-#include <map>
+#include <unordered_map>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -21,15 +21,18 @@ std::shared_ptr<const Submap> FromTree(std::unique_ptr<octomap::OcTree> tree, ui
 }
 
 // Finest-level log-odds of every known voxel (pruned leaves expanded).
-std::map<std::tuple<int, int, int>, float> Voxels(const octomap::OcTree& t) {
-  std::map<std::tuple<int, int, int>, float> out;
+using VoxelMap = std::unordered_map<uint64_t, float>;
+uint64_t Key(int x, int y, int z) { return VoxelKey::Pack(x - 32768, y - 32768, z - 32768); }
+
+VoxelMap Voxels(const octomap::OcTree& t) {
+  VoxelMap out;
   const int depth = static_cast<int>(t.getTreeDepth());
   for (auto it = t.begin_leafs(); it != t.end_leafs(); ++it) {
     const int n = 1 << (depth - static_cast<int>(it.getDepth()));
     const octomap::OcTreeKey k = it.getIndexKey();
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) out[{k[0] + x, k[1] + y, k[2] + z}] = it->getLogOdds();
+        for (int x = 0; x < n; ++x) out[Key(k[0] + x, k[1] + y, k[2] + z)] = it->getLogOdds();
   }
   return out;
 }
@@ -56,9 +59,10 @@ TEST(MapComposerTest, GebMergedWithShiftedCopyGivesSummedClampedLogOdds) {
   const CompositionStats st = composer.Update();
   EXPECT_EQ(st.rebuilt, 2);
   const auto merged = Voxels(*composer.Octree());
-  std::map<std::tuple<int, int, int>, float> expected = va;
+  VoxelMap expected = va;
   for (const auto& [k, v] : va) {
-    const auto ks = std::make_tuple(std::get<0>(k) + sx, std::get<1>(k) + sy, std::get<2>(k));
+    const Eigen::Vector3i c = VoxelKey::Unpack(k);
+    const uint64_t ks = VoxelKey::Pack(c.x() + sx, c.y() + sy, c.z());
     auto it = expected.find(ks);
     if (it == expected.end()) expected[ks] = v;
     else it->second = std::clamp(it->second + v, -2.0f, 3.5f);

@@ -127,7 +127,12 @@ int RunMap(const CommandArgs& args) {
       auto s = SubmapCodec::ReadFile(in.substr(0, at));
       if (!s.ok()) return Fail(s.status());
       if (composer == nullptr) composer = std::make_unique<MapComposer>(CompositionOptions{}, (*s)->metadata().options);
+      const size_t before = composer->submap_count();
       if (Status st = composer->SetSubmap(*s, T); !st.ok()) return Fail(st.WithContext(in));
+      if (composer->submap_count() == before) {
+        return Fail(InvalidArgumentError("submap " + (*s)->metadata().robot + "/" + std::to_string((*s)->metadata().id) +
+                                         " given twice (" + in + ")"));
+      }
     }
     const auto t0 = Clock::now();
     composer->Update();
@@ -146,8 +151,6 @@ int RunMap(const CommandArgs& args) {
   std::fprintf(stderr, "cairn map: unknown verb '%s'\n%s", verb.c_str(), kMapUsage);
   return 2;
 }
-
-
 
 int RunBenchMap(const CommandArgs& args) {
   int images = 44;
