@@ -26,6 +26,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"bench graph", "online SLAM graph on thesis-sized multi-robot graphs: update and covariance times", RunBenchGraph},
     {"sim", "simulate a multi-robot mission into EuRoC/ASL folders and CAN logs", RunSim},
     {"bench sim", "time rendering a stereo pair of the simulator's default world", RunBenchSim},
+    {"map", "submap files: info, export (PCD/PLY, .bt/.ot), compose", RunMap},
+    {"bench map", "time local mapping (classification, submap integration, wire size, composition)", RunBenchMap},
 });
 
 void PrintHelp() {

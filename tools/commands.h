@@ -26,3 +26,10 @@ int RunSim(const CommandArgs& args);
 int RunBenchSim(const CommandArgs& args);
 
 }  // namespace cairn::tools
+
+namespace cairn::tools {
+
+int RunMap(const CommandArgs& args);
+int RunBenchMap(const CommandArgs& args);
+
+}  // namespace cairn::tools

@@ -1,0 +1,176 @@
+// Mapping against the simulator's ground truth: occupied voxels vs. the true surface, and a
+// partitioned submap chain re-composed. (Obstacle precision/recall is measured by
+// `cairn bench map`.)
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "mapping/local_mapper.h"
+#include "mapping/map_composer.h"
+#include "mapping/sim_depth_scenes.h"
+
+namespace cairn {
+namespace {
+
+using testing::ForwardCameraPose;
+
+constexpr double kTilt = 25.0 * 3.14159265358979 / 180.0;
+
+sim::Terrain World() {
+  sim::WorldOptions w;
+  w.size = 40.0;
+  w.seed = 11;
+  w.lander.clear();
+  return sim::Terrain::Generate(w);
+}
+
+DepthImage Render(const sim::Terrain& terrain, const StereoCamera& cam, const Eigen::Isometry3d& T_world_cam, unsigned seed) {
+  return testing::RenderSimulatedDepth(terrain, cam, T_world_cam, seed, 0.2);
+}
+
+Eigen::Isometry3d CameraAt(const sim::Terrain& t, double x, double y, double yaw) {
+  return ForwardCameraPose({x, y, t.Height(x, y) + 1.3}, yaw, kTilt);
+}
+
+// Distance from `c` to the true surface (dense samples within 0.2 m around it).
+double SurfaceDistance(const sim::Terrain& t, const octomap::point3d& c) {
+  double best = 1e9;
+  for (int sy = -10; sy <= 10; ++sy) {
+    for (int sx = -10; sx <= 10; ++sx) {
+      const double x = c.x() + 0.02 * sx, y = c.y() + 0.02 * sy;
+      const double dz = c.z() - t.Height(x, y);
+      best = std::min(best, std::sqrt(0.0004 * (sx * sx + sy * sy) + dz * dz));
+    }
+  }
+  return best;
+}
+
+struct SwitchRecorder : FrameSwitchRequesterInterface {
+  int requests = 0;
+  void RequestFrameSwitch(const FrameSwitchRequest&) override { ++requests; }
+};
+
+// Gravity-aligned frame at a pose's position and yaw (what the filter switches into).
+Eigen::Isometry3d YawFrame(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d fwd = T.linear().col(0);
+  Eigen::Isometry3d F = Eigen::Isometry3d::Identity();
+  F.linear() = Eigen::AngleAxisd(std::atan2(fwd.y(), fwd.x()), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  F.translation() = T.translation();
+  return F;
+}
+
+// A drive of 11 m with the distance criterion at 4 m: the partitioner asks for switches, the test
+// plays the filter (switching into the body's position and yaw, with a drift of 0.5 % of the
+// distance in the local poses), and the submap chain composed along the filter's frame-switch
+// transforms (no loop closures) lies on the true surface within one voxel plus the drift.
+TEST(MappingSimTest, PartitionedSubmapChainRecomposesToGroundTruth) {
+  const sim::Terrain terrain = World();
+  StereoCamera cam = testing::RoverCamera(0.5);
+  // Body frame = x forward, z up at the camera mast; camera pitched down.
+  cam.T_body_cam = ForwardCameraPose(Eigen::Vector3d::Zero(), 0.0, kTilt);
+  MappingOptions o;
+  o.partition.max_distance = 4.0;
+  SwitchRecorder rec;
+  LocalMapper mapper(o, cam, "rover1", &rec);
+  const double drift = 0.005;
+  uint64_t frame = 1;
+  Eigen::Isometry3d T_world_frame_true = Eigen::Isometry3d::Identity();  // true pose of the local frame
+  Eigen::Isometry3d T_world_frame_est = Eigen::Isometry3d::Identity();   // chained from the filter
+  double dist_in_frame = 0.0;
+  std::vector<std::pair<std::shared_ptr<const Submap>, Eigen::Isometry3d>> chain;
+  Eigen::Vector3d last(0, 0, 0);
+  bool first = true;
+  for (int i = 0; i <= 44; ++i) {
+    const double s = 0.25 * i;
+    const double x = -5.0 + s, y = 1.5 * std::sin(0.25 * s), yaw = std::atan(1.5 * 0.25 * std::cos(0.25 * s));
+    Eigen::Isometry3d T_world_body = Eigen::Isometry3d::Identity();
+    T_world_body.linear() = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    T_world_body.translation() = Eigen::Vector3d(x, y, terrain.Height(x, y) + 1.3);
+    if (first) {
+      T_world_frame_true = T_world_frame_est = YawFrame(T_world_body);
+      first = false;
+    } else {
+      dist_in_frame += (T_world_body.translation() - last).norm();
+    }
+    last = T_world_body.translation();
+    // The filter's local pose: true relative pose plus drift along the local x axis.
+    Eigen::Isometry3d T_local_body = T_world_frame_true.inverse() * T_world_body;
+    T_local_body.translation().x() += drift * dist_in_frame;
+    const int before = rec.requests;
+    MappingPose pose;
+    pose.time = Timestamp::FromSeconds(s);
+    pose.frame_id = frame;
+    pose.T_local_body = T_local_body;
+    pose.position_covariance = Eigen::Matrix3d::Identity() * 1e-4;
+    ASSERT_TRUE(mapper.Process(Render(terrain, cam, T_world_body * cam.T_body_cam, 100 + i), pose).ok());
+    if (rec.requests > before) {
+      // Switch into the body's estimated position and yaw in the old frame.
+      const Eigen::Isometry3d T_old_new = YawFrame(T_local_body);
+      auto done = mapper.OnFrameSwitch(frame + 1, T_old_new);
+      ASSERT_NE(done, nullptr);
+      chain.emplace_back(done, T_world_frame_est);
+      T_world_frame_est = T_world_frame_est * T_old_new;
+      T_world_frame_true = YawFrame(T_world_body);
+      ++frame;
+      dist_in_frame = 0.0;
+    }
+  }
+  EXPECT_EQ(rec.requests, 2);
+  ASSERT_EQ(chain.size(), 2u);
+  MapComposer composer(o.composition, o.submap);
+  for (const auto& [submap, T] : chain) ASSERT_TRUE(composer.SetSubmap(submap, T).ok());
+  composer.SetOpenSubmap(&mapper.open_submap(), T_world_frame_est);
+  composer.Update();
+  const auto tree = composer.Octree();
+  int64_t occupied = 0, near = 0;
+  // One voxel plus the largest drift (4 m x 0.5 % per frame, two frames chained so far).
+  const double bound = o.submap.octree_resolution + 3 * 4.0 * drift;
+  for (auto it = tree->begin_leafs(); it != tree->end_leafs(); ++it) {
+    if (!tree->isNodeOccupied(*it)) continue;
+    const octomap::point3d c = it.getCoordinate();
+    ++occupied;
+    near += SurfaceDistance(terrain, c) <= bound;
+  }
+  std::printf("composed occupied voxels %ld, within %.3f m of the surface %.2f %%\n", static_cast<long>(occupied), bound,
+              100.0 * static_cast<double>(near) / static_cast<double>(occupied));
+  EXPECT_GT(occupied, 3000);
+  EXPECT_GE(static_cast<double>(near), 0.95 * static_cast<double>(occupied));
+}
+
+// Single submap with exact poses: occupied voxels lie within one voxel of the true surface.
+TEST(MappingSimTest, OccupiedVoxelsLieOnTheTrueSurface) {
+  const sim::Terrain terrain = World();
+  const StereoCamera cam = testing::RoverCamera(1.0);
+  MappingOptions o;
+  SwitchRecorder rec;
+  LocalMapper mapper(o, cam, "rover1", &rec);
+  for (int i = 0; i < 12; ++i) {
+    const Eigen::Isometry3d T = CameraAt(terrain, 2.0 + 0.3 * i, -3.0 + 0.1 * i, 1.2);
+    MappingPose pose;
+    pose.frame_id = 1;
+    pose.T_local_body = T;
+    ASSERT_TRUE(mapper.Process(Render(terrain, cam, T, 7 + i), pose).ok());
+  }
+  const auto submap = mapper.OnFrameSwitch(2, Eigen::Isometry3d::Identity());
+  ASSERT_NE(submap, nullptr);
+  int64_t occupied = 0, near = 0;
+  for (auto it = submap->tree().begin_leafs(); it != submap->tree().end_leafs(); ++it) {
+    if (!submap->tree().isNodeOccupied(*it)) continue;
+    const octomap::point3d c = it.getCoordinate();
+    ++occupied;
+    near += SurfaceDistance(terrain, c) <= submap->tree().getResolution();
+  }
+  std::printf("occupied voxels %ld, within one voxel of the surface %.2f %%\n", static_cast<long>(occupied),
+              100.0 * static_cast<double>(near) / static_cast<double>(occupied));
+  EXPECT_GT(occupied, 2000);
+  EXPECT_GE(static_cast<double>(near), 0.95 * static_cast<double>(occupied));
+  // The cloud points carry the classifier's obstacle flags.
+  EXPECT_GT(submap->points().size(), 10000u);
+}
+
+}  // namespace
+}  // namespace cairn

@@ -1,0 +1,159 @@
+#include "mapping/obstacle_classifier.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cairn {
+
+ObstacleClassifier::ObstacleClassifier(const ObstacleOptions& options, const StereoCamera& camera,
+                                       const StereoErrorModel& model, double range)
+    : options_(options), camera_(camera), model_(model) {
+  n_ = 2 * static_cast<int>(std::ceil(range / options.cell_size)) + 2 * static_cast<int>(options.window_cells) + 2;
+  const size_t cells = static_cast<size_t>(n_) * static_cast<size_t>(n_);
+  sum_z_.assign(cells, 0.0f);
+  count_.assign(cells, 0);
+  edge_ratio_.assign(cells, 0.0f);
+  cell_obstacle_.assign(cells, 0);
+  touched_.reserve(cells);
+  last_depth_.resize(static_cast<size_t>(camera.intrinsics.width));
+  last_row_.resize(static_cast<size_t>(camera.intrinsics.width));
+}
+
+double ObstacleClassifier::MinimalSlope(const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+  const double run = std::hypot(q.x() - p.x(), q.y() - p.y());
+  if (run <= 0.0) return p.z() > q.z() ? std::numeric_limits<double>::infinity() : 0.0;
+  return (p.z() - q.z()) / run;
+}
+
+// Row by row rather than column by column: the same comparisons of each pixel with the last valid
+// one above it, in memory order.
+void ObstacleClassifier::FindNegativeEdges(const DepthImage& image, const Eigen::Isometry3d& T_local_cam) {
+  const PinholeRadTan& k = camera_.intrinsics;
+  std::fill(last_row_.begin(), last_row_.end(), -1);
+  edges_.clear();
+  const float jump = static_cast<float>(options_.edge_jump);
+  const int gap = static_cast<int>(options_.edge_max_gap_rows);
+  const double far = options_.edge_max_range;
+  const float sigmas = static_cast<float>(options_.edge_jump_sigmas);
+  const float c = static_cast<float>(model_.DepthError(1.0));  // eq. 5.2c: c z^2
+  const auto point = [&](int u, int v, double z) {
+    return Eigen::Vector3d(T_local_cam * Eigen::Vector3d((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z));
+  };
+  for (int v = 0; v < image.height; ++v) {
+    const float* row = image.depth.data() + static_cast<size_t>(v) * static_cast<size_t>(image.width);
+    for (int u = 0; u < image.width; ++u) {
+      const float z = row[u];
+      if (std::isnan(z)) continue;
+      const int above = last_row_[static_cast<size_t>(u)];
+      const float upper = last_depth_[static_cast<size_t>(u)];
+      last_row_[static_cast<size_t>(u)] = v;
+      last_depth_[static_cast<size_t>(u)] = z;
+      if (above < 0 || v - above - 1 > gap || !(upper - z > jump) || !std::isfinite(z)) continue;
+      if (!(upper - z > jump + sigmas * c * z * z)) continue;
+      const Eigen::Vector3d p = point(u, v, z);
+      const Eigen::Vector3d q = point(u, above, std::min(static_cast<double>(upper), far));
+      const double s = MinimalSlope(p, q);
+      if (s > options_.max_slope) {
+        edges_.push_back({static_cast<uint32_t>(v * image.width + u), static_cast<float>(s / options_.max_slope)});
+      }
+    }
+  }
+}
+
+Status ObstacleClassifier::Classify(const DepthImage& image, CameraPoints* pts, ObstacleResult* result) {
+  result->Clear();
+  if (image.width != camera_.intrinsics.width || image.height != camera_.intrinsics.height ||
+      image.depth.size() != static_cast<size_t>(image.width) * static_cast<size_t>(image.height)) {
+    return InvalidArgumentError("obstacle classification: depth image does not match the camera");
+  }
+  FindNegativeEdges(image, pts->T_local_cam);
+
+  // Height grid centred on the camera, aligned with the local frame's axes.
+  const double cell = options_.cell_size;
+  const float inv = static_cast<float>(1.0 / cell);
+  const Eigen::Vector3d cam = pts->T_local_cam.translation();
+  const int ox = static_cast<int>(std::floor(cam.x() / cell)) - n_ / 2;
+  const int oy = static_cast<int>(std::floor(cam.y() / cell)) - n_ / 2;
+  const int margin = static_cast<int>(options_.window_cells);
+  for (int32_t c : touched_) {
+    sum_z_[static_cast<size_t>(c)] = 0.0f;
+    count_[static_cast<size_t>(c)] = 0;
+    edge_ratio_[static_cast<size_t>(c)] = 0.0f;
+    cell_obstacle_[static_cast<size_t>(c)] = 0;
+  }
+  touched_.clear();
+  const size_t np = pts->size();
+  cell_of_point_.resize(np);
+  size_t e = 0;
+  for (size_t i = 0; i < np; ++i) {
+    const Eigen::Vector3f& p = pts->p_local[i];
+    const int gx = static_cast<int>(std::floor(p.x() * inv)) - ox;
+    const int gy = static_cast<int>(std::floor(p.y() * inv)) - oy;
+    if (gx < margin || gy < margin || gx >= n_ - margin || gy >= n_ - margin) {
+      cell_of_point_[i] = -1;
+      continue;
+    }
+    const int32_t c = gy * n_ + gx;
+    cell_of_point_[i] = c;
+    const size_t cs = static_cast<size_t>(c);
+    if (count_[cs] == 0) touched_.push_back(c);
+    sum_z_[cs] += p.z();
+    ++count_[cs];
+    // Points and edges are both in pixel order.
+    while (e < edges_.size() && edges_[e].pixel < pts->pixel[i]) ++e;
+    if (e < edges_.size() && edges_[e].pixel == pts->pixel[i]) {
+      edge_ratio_[cs] = std::max(edge_ratio_[cs], edges_[e].ratio);
+      ++result->negative_edges;
+    }
+  }
+  for (int32_t c : touched_) sum_z_[static_cast<size_t>(c)] /= static_cast<float>(count_[static_cast<size_t>(c)]);
+
+  // Window of w cells around each observed cell: [-(w-1)/2, w/2] (even windows lean positive).
+  const int w = static_cast<int>(options_.window_cells);
+  const int lo = -(w - 1) / 2, hi = w / 2;
+  const Eigen::Isometry3d T_cam_local = pts->T_local_cam.inverse();
+  const double h_max = options_.max_step;
+  result->cells.reserve(touched_.size());
+  for (int32_t c : touched_) {
+    const int gx = c % n_, gy = c / n_;
+    float zmax = -std::numeric_limits<float>::infinity(), zmin = std::numeric_limits<float>::infinity();
+    int cmax = c, cmin = c;
+    for (int dy = lo; dy <= hi; ++dy) {
+      const int row = (gy + dy) * n_;
+      for (int dx = lo; dx <= hi; ++dx) {
+        const size_t q = static_cast<size_t>(row + gx + dx);
+        if (count_[q] == 0) continue;
+        const float h = sum_z_[q];
+        if (h > zmax) { zmax = h; cmax = static_cast<int>(q); }
+        if (h < zmin) { zmin = h; cmin = static_cast<int>(q); }
+      }
+    }
+    const double h_diff = static_cast<double>(zmax - zmin);
+    double threshold = h_max;
+    if (options_.error_adaptive && cmax != cmin) {
+      const auto centre = [&](int q) {
+        return Eigen::Vector3d((ox + q % n_ + 0.5) * cell, (oy + q / n_ + 0.5) * cell, sum_z_[static_cast<size_t>(q)]);
+      };
+      threshold += model_.DistanceError(T_cam_local * centre(cmax), T_cam_local * centre(cmin));
+    }
+    const size_t cs = static_cast<size_t>(c);
+    ObstacleCell out;
+    out.x = static_cast<float>((ox + gx + 0.5) * cell);
+    out.y = static_cast<float>((oy + gy + 0.5) * cell);
+    out.height = sum_z_[cs];
+    out.negative_edge = edge_ratio_[cs] > 1.0f;
+    out.traversability = std::max(static_cast<float>(h_diff / threshold), edge_ratio_[cs]);
+    out.obstacle = h_diff > threshold || out.negative_edge;
+    cell_obstacle_[cs] = out.obstacle;
+    result->cells.push_back(out);
+  }
+  for (size_t i = 0; i < np; ++i) {
+    const int32_t c = cell_of_point_[i];
+    pts->obstacle[i] = c >= 0 && cell_obstacle_[static_cast<size_t>(c)];
+    result->obstacle_points += pts->obstacle[i];
+  }
+  return Status::Ok();
+}
+
+}  // namespace cairn

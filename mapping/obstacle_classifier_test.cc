@@ -1,0 +1,176 @@
+#include "mapping/obstacle_classifier.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "mapping/depth_projector.h"
+#include "mapping/mapping_test_scenes.h"
+
+namespace cairn {
+namespace {
+
+using testing::ForwardCameraPose;
+using testing::RenderDepth;
+using testing::RoverCamera;
+
+// Ground z = 0 up to x = edge, then a vertical drop to z = -drop (the face looks away from the
+// camera, so it is never seen: a negative edge).
+double CliffHit(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double edge, double drop) {
+  if (d.z() >= 0.0) return -1.0;
+  const double t0 = -o.z() / d.z();
+  if (o.x() + t0 * d.x() < edge) return t0;
+  return (-drop - o.z()) / d.z();
+}
+
+TEST(ObstacleClassifierTest, MinimalSlopeMatchesEquation51ByHand) {
+  // Rise 1.5 over a run of hypot(3, 4) = 5: 0.3.
+  EXPECT_DOUBLE_EQ(ObstacleClassifier::MinimalSlope({1, 2, 0.5}, {4, 6, -1.0}), 0.3);
+  EXPECT_DOUBLE_EQ(ObstacleClassifier::MinimalSlope({0, 0, 0}, {0, 2, 0.4}), -0.2);
+  EXPECT_TRUE(std::isinf(ObstacleClassifier::MinimalSlope({0, 0, 1}, {0, 0, 0})));
+}
+
+struct Scene {
+  StereoCamera cam = RoverCamera(0.5);
+  DepthPointOptions depth_options;
+  ObstacleOptions options;
+};
+
+int CountObstacleCells(const ObstacleResult& r, double min_x, double max_x) {
+  int n = 0;
+  for (const ObstacleCell& c : r.cells) n += c.obstacle && c.x >= min_x && c.x < max_x;
+  return n;
+}
+
+TEST(ObstacleClassifierTest, NegativeEdgeAtSyntheticCliff) {
+  Scene s;
+  const Eigen::Isometry3d T = ForwardCameraPose({0, 0, 1.3}, 0.0, 0.44);
+  const DepthImage img = RenderDepth(s.cam, T, [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    return CliffHit(o, d, 2.5, 3.0);
+  });
+  DepthProjector proj(s.depth_options, s.cam);
+  ObstacleClassifier cls(s.options, s.cam, proj.error_model(), proj.range());
+  CameraPoints pts;
+  ObstacleResult r;
+  ASSERT_TRUE(proj.Project(img, Eigen::Isometry3d(T), &pts).ok());
+  ASSERT_TRUE(cls.Classify(img, &pts, &r).ok());
+  // The far ground is 3 m lower and beyond the points' range: only the edge itself can tell. The
+  // ray over the edge meets it 8.3 m out, so eq. 5.1 gives 3 / 5.8 = 0.52 > 0.4.
+  EXPECT_GT(r.negative_edges, s.cam.intrinsics.width / 2);
+  int edge_cells = 0, wrong = 0;
+  for (const ObstacleCell& c : r.cells) {
+    if (c.negative_edge) {
+      ++edge_cells;
+      EXPECT_NEAR(c.x, 2.5, 0.06) << "edge cell away from the cliff at y " << c.y;
+      EXPECT_GT(c.traversability, 1.0f);
+    }
+    if (c.obstacle && c.x < 2.4) ++wrong;
+  }
+  EXPECT_GT(edge_cells, 20);
+  EXPECT_EQ(wrong, 0);
+  // Points on the edge are flagged, points on the flat ground before it are not.
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (pts.p_local[i].x() < 2.35) {
+      ASSERT_EQ(pts.obstacle[i], 0) << i;
+    }
+  }
+
+  // A robot that can drive any slope sees no negative edge although depth jumps.
+  ObstacleOptions lenient = s.options;
+  lenient.max_slope = 100.0;
+  ObstacleClassifier cls2(lenient, s.cam, proj.error_model(), proj.range());
+  ASSERT_TRUE(cls2.Classify(img, &pts, &r).ok());
+  EXPECT_EQ(r.negative_edges, 0);
+}
+
+TEST(ObstacleClassifierTest, StepAboveMaxStepIsObstacleAndBelowIsNot) {
+  Scene s;
+  const Eigen::Isometry3d T = ForwardCameraPose({0, 0, 1.3}, 0.0, 0.44);
+  // A box 0.3 m high and another 0.08 m high (below h_max = 0.15 m) on flat ground.
+  const auto scene = [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    double best = d.z() < 0 ? -o.z() / d.z() : -1.0;
+    const struct { double x0, x1, y0, y1, h; } boxes[] = {{2.5, 2.9, -0.6, -0.2, 0.3}, {2.5, 2.9, 0.2, 0.6, 0.08}};
+    for (const auto& b : boxes) {
+      // Slab test against the box [x0,x1] x [y0,y1] x [0,h].
+      double tmin = 0.0, tmax = 1e9;
+      const double lo[3] = {b.x0, b.y0, 0.0}, hi[3] = {b.x1, b.y1, b.h};
+      bool miss = false;
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(d[a]) < 1e-12) {
+          if (o[a] < lo[a] || o[a] > hi[a]) miss = true;
+          continue;
+        }
+        double t0 = (lo[a] - o[a]) / d[a], t1 = (hi[a] - o[a]) / d[a];
+        if (t0 > t1) std::swap(t0, t1);
+        tmin = std::max(tmin, t0);
+        tmax = std::min(tmax, t1);
+      }
+      if (!miss && tmin <= tmax && tmin > 0 && (best < 0 || tmin < best)) best = tmin;
+    }
+    return best;
+  };
+  const DepthImage img = RenderDepth(s.cam, T, scene, 0.1, 3);
+  DepthProjector proj(s.depth_options, s.cam);
+  ObstacleClassifier cls(s.options, s.cam, proj.error_model(), proj.range());
+  CameraPoints pts;
+  ObstacleResult r;
+  ASSERT_TRUE(proj.Project(img, T, &pts).ok());
+  ASSERT_TRUE(cls.Classify(img, &pts, &r).ok());
+  int high = 0, low = 0, elsewhere = 0;
+  for (const ObstacleCell& c : r.cells) {
+    if (!c.obstacle) continue;
+    if (c.x > 2.3 && c.x < 3.1 && c.y > -0.8 && c.y < 0.0) ++high;
+    else if (c.x > 2.3 && c.x < 3.1 && c.y > 0.0 && c.y < 0.8) ++low;
+    else ++elsewhere;
+  }
+  EXPECT_GT(high, 20);
+  EXPECT_EQ(low, 0);
+  EXPECT_EQ(elsewhere, 0);
+}
+
+// Flat ground seen to 9 m with stereo noise (0.25 px per pixel, independent: sub-pixel SGM noise
+// without its spatial smoothing): the far cells' height differences are noise. A fixed threshold
+// h_max reports many of them; h_max + delta_d (eq. 5.4) suppresses them (not all: delta_d is the
+// error of the cells' distance, which underrates height noise for cells side by side), and near
+// cells are unaffected.
+TEST(ObstacleClassifierTest, ErrorAdaptiveThresholdSuppressesFarFalseObstacles) {
+  Scene s;
+  s.depth_options.max_depth_error = 1.0;  // keep points out to max_depth
+  s.depth_options.max_depth = 9.0;
+  const Eigen::Isometry3d T = ForwardCameraPose({0, 0, 1.3}, 0.0, 0.25);
+  const DepthImage img = RenderDepth(s.cam, T, [](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    return d.z() < 0 ? -o.z() / d.z() : -1.0;
+  }, 0.25, 7);
+  DepthProjector proj(s.depth_options, s.cam);
+  CameraPoints pts;
+  ASSERT_TRUE(proj.Project(img, T, &pts).ok());
+  ObstacleOptions fixed = s.options;
+  fixed.error_adaptive = false;
+  ObstacleClassifier adaptive_cls(s.options, s.cam, proj.error_model(), proj.range());
+  ObstacleClassifier fixed_cls(fixed, s.cam, proj.error_model(), proj.range());
+  ObstacleResult a, f;
+  ASSERT_TRUE(fixed_cls.Classify(img, &pts, &f).ok());
+  ASSERT_TRUE(adaptive_cls.Classify(img, &pts, &a).ok());
+  const int fixed_far = CountObstacleCells(f, 5.0, 10.0);
+  const int adaptive_far = CountObstacleCells(a, 5.0, 10.0);
+  EXPECT_GT(fixed_far, 50);
+  EXPECT_LE(adaptive_far, fixed_far / 20);
+  EXPECT_EQ(CountObstacleCells(a, 0.0, 3.0), 0);
+}
+
+TEST(ObstacleClassifierTest, RejectsImageOfWrongSize) {
+  Scene s;
+  DepthProjector proj(s.depth_options, s.cam);
+  ObstacleClassifier cls(s.options, s.cam, proj.error_model(), proj.range());
+  DepthImage img;
+  img.width = 10;
+  img.height = 10;
+  img.depth.assign(100, 1.0f);
+  CameraPoints pts;
+  ObstacleResult r;
+  EXPECT_FALSE(proj.Project(img, Eigen::Isometry3d::Identity(), &pts).ok());
+  EXPECT_EQ(cls.Classify(img, &pts, &r).code(), StatusCode::kInvalidArgument);
+}
+
+}  // namespace
+}  // namespace cairn

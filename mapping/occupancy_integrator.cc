@@ -1,0 +1,86 @@
+#include "mapping/occupancy_integrator.h"
+
+#include <cmath>
+
+namespace cairn {
+namespace {
+uint64_t PackOctoKey(const octomap::OcTreeKey& k) { return VoxelKey::Pack(k[0], k[1], k[2]); }
+}  // namespace
+
+std::unique_ptr<octomap::OcTree> MakeOccupancyTree(const SubmapOptions& o) {
+  auto tree = std::make_unique<octomap::OcTree>(o.octree_resolution);
+  tree->setProbHit(octomap::probability(static_cast<float>(o.log_odds_hit)));
+  tree->setProbMiss(octomap::probability(static_cast<float>(o.log_odds_miss)));
+  tree->setClampingThresMin(octomap::probability(static_cast<float>(o.log_odds_min)));
+  tree->setClampingThresMax(octomap::probability(static_cast<float>(o.log_odds_max)));
+  return tree;
+}
+
+OccupancyIntegrator::OccupancyIntegrator(double resolution, double max_distance) : res_(resolution) {
+  side_ = 2 * static_cast<int>(std::ceil(max_distance / resolution)) + 4;
+  stamps_.assign(static_cast<size_t>(side_) * static_cast<size_t>(side_) * static_cast<size_t>(side_), 0);
+}
+
+uint32_t& OccupancyIntegrator::Stamp(const octomap::OcTreeKey& k) {
+  const int h = side_ / 2;
+  const int x = k[0] - centre_[0] + h, y = k[1] - centre_[1] + h, z = k[2] - centre_[2] + h;
+  if (x >= 0 && y >= 0 && z >= 0 && x < side_ && y < side_ && z < side_) {
+    return stamps_[(static_cast<size_t>(z) * static_cast<size_t>(side_) + static_cast<size_t>(y)) * static_cast<size_t>(side_) + static_cast<size_t>(x)];
+  }
+  return overflow_[PackOctoKey(k)];
+}
+
+OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, octomap::OcTree* tree) {
+  OccupancyUpdateStats stats;
+  // Stamps: generation g marks "free this image", g + 1 "occupied this image"; older values are
+  // stale. On wrap-around everything is reset once.
+  if (generation_ >= 0xFFFFFFF0u) {
+    std::fill(stamps_.begin(), stamps_.end(), 0u);
+    overflow_.Clear();
+    generation_ = 0;
+  }
+  generation_ += 2;
+  const uint32_t kFree = generation_, kOccupied = generation_ + 1;
+  const Eigen::Vector3d o = pts.T_local_cam.translation();
+  const octomap::point3d origin(static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z()));
+  if (!tree->coordToKeyChecked(origin, centre_)) return stats;
+  overflow_.Clear();
+  occupied_.clear();
+  free_.clear();
+  octomap::OcTreeKey key;
+  for (const Eigen::Vector3f& p : pts.p_local) {
+    if (!tree->coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+    uint32_t& s = Stamp(key);
+    if (s != kOccupied) {
+      s = kOccupied;
+      occupied_.push_back(key);
+    }
+  }
+  const auto cast = [&](const octomap::point3d& end) {
+    ++stats.rays;
+    if (!tree->computeRayKeys(origin, end, ray_)) return;
+    for (const octomap::OcTreeKey& k : ray_) {
+      uint32_t& s = Stamp(k);
+      if (s < kFree) {
+        s = kFree;
+        free_.push_back(k);
+      }
+    }
+  };
+  for (const octomap::OcTreeKey& k : occupied_) cast(tree->keyToCoord(k));
+  far_seen_.Clear();
+  for (const Eigen::Vector3f& p : pts.far_local) {
+    if (!tree->coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+    uint8_t& seen = far_seen_[PackOctoKey(key)];
+    if (seen) continue;
+    seen = 1;
+    cast(tree->keyToCoord(key));
+  }
+  for (const octomap::OcTreeKey& k : free_) tree->updateNode(k, false, true);
+  for (const octomap::OcTreeKey& k : occupied_) tree->updateNode(k, true, true);
+  stats.occupied = static_cast<int64_t>(occupied_.size());
+  stats.free = static_cast<int64_t>(free_.size());
+  return stats;
+}
+
+}  // namespace cairn

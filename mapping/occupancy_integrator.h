@@ -1,0 +1,54 @@
+#pragma once
+// Integrates one depth image into an OctoMap occupancy tree (thesis 5.1.2, eqs. 5.8, 5.9) with the
+// semantics of OctoMap's insertPointCloud with discretization: each endpoint voxel is hit once,
+// one ray is cast from the sensor to the centre of each distinct endpoint voxel (instead of one per
+// pixel), every voxel is updated at most once per image and occupied wins over free. What makes it
+// fast is bookkeeping, not different results: a dense generation-stamped cube around the camera
+// replaces OctoMap's hash sets, so deduplicating a voxel costs one array access, and the tree is
+// updated lazily (inner nodes once when the submap is finished).
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "mapping/depth_image.h"
+#include "mapping/mapping_options.h"
+#include "mapping/voxel_hash_map.h"
+
+namespace cairn {
+
+// A tree configured with the submap options' resolution, log-odds and clamping.
+std::unique_ptr<octomap::OcTree> MakeOccupancyTree(const SubmapOptions& options);
+
+struct OccupancyUpdateStats {
+  int64_t occupied = 0;  // voxels updated as occupied
+  int64_t free = 0;      // voxels updated as free
+  int64_t rays = 0;
+};
+
+class OccupancyIntegrator {
+ public:
+  // `max_distance` bounds the distance of endpoints from the camera (sizes the dense cube; voxels
+  // beyond it still work through a slower hash map).
+  OccupancyIntegrator(double resolution, double max_distance);
+
+  // Adds the points (local frame, already filtered by range) and the free-only ray ends.
+  OccupancyUpdateStats Integrate(const CameraPoints& points, octomap::OcTree* tree);
+
+ private:
+  uint32_t& Stamp(const octomap::OcTreeKey& k);
+
+  double res_;
+  int side_ = 0;
+  octomap::OcTreeKey centre_;
+  std::vector<uint32_t> stamps_;
+  VoxelHashMap<uint32_t> overflow_;
+  uint32_t generation_ = 0;
+  std::vector<octomap::OcTreeKey> occupied_, free_;
+  VoxelHashMap<uint8_t> far_seen_;
+  octomap::KeyRay ray_;
+};
+
+}  // namespace cairn

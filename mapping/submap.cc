@@ -1,0 +1,40 @@
+#include "mapping/submap.h"
+
+#include <utility>
+
+namespace cairn {
+
+Submap::Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree)
+    : metadata_(std::move(metadata)), points_(std::move(points)), tree_(std::move(tree)) {}
+
+int64_t Submap::obstacle_points() const {
+  int64_t n = 0;
+  for (const CloudPoint& p : points_) n += p.obstacle;
+  return n;
+}
+
+OpenSubmap::OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id)
+    : cloud_(options.cloud_resolution, 1 << 16), tree_(MakeOccupancyTree(options)) {
+  metadata_.robot = std::move(robot);
+  metadata_.id = id;
+  metadata_.options = options;
+}
+
+OccupancyUpdateStats OpenSubmap::Integrate(const CameraPoints& pts, OccupancyIntegrator* integrator) {
+  if (metadata_.images == 0) metadata_.start = pts.time;
+  metadata_.end = pts.time;
+  ++metadata_.images;
+  cloud_.AddBatch(pts.p_local, pts.intensity, pts.obstacle);
+  return integrator->Integrate(pts, tree_.get());
+}
+
+std::shared_ptr<const Submap> OpenSubmap::Finish() {
+  tree_->updateInnerOccupancy();
+  tree_->prune();
+  auto submap = std::make_shared<const Submap>(metadata_, cloud_.Points(), std::move(tree_));
+  tree_ = MakeOccupancyTree(metadata_.options);
+  cloud_.Clear();
+  return submap;
+}
+
+}  // namespace cairn

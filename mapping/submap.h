@@ -1,0 +1,66 @@
+#pragma once
+// Submaps (thesis 5.1.2): a local frame of the filter with the point cloud and the occupancy tree
+// aggregated in it. An OpenSubmap grows with every depth image; Finish() turns it into an
+// immutable Submap that is shared (std::shared_ptr<const Submap>) with composition, matching and
+// teammates.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "hal/timestamp.h"
+#include "mapping/mapping_options.h"
+#include "mapping/occupancy_integrator.h"
+#include "mapping/voxel_cloud.h"
+
+namespace cairn {
+
+struct SubmapMetadata {
+  std::string robot;          // at most 255 bytes
+  uint64_t id = 0;            // the filter's local frame id, unique per robot
+  Timestamp start, end;       // first and last integrated image
+  uint32_t images = 0;
+  double distance = 0.0;      // m travelled in the frame
+  SubmapOptions options;      // resolutions and log-odds the maps were made with
+};
+
+class Submap {
+ public:
+  Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree);
+
+  const SubmapMetadata& metadata() const { return metadata_; }
+  const std::vector<CloudPoint>& points() const { return points_; }
+  const octomap::OcTree& tree() const { return *tree_; }
+  int64_t obstacle_points() const;
+
+ private:
+  SubmapMetadata metadata_;
+  std::vector<CloudPoint> points_;
+  std::unique_ptr<const octomap::OcTree> tree_;
+};
+
+class OpenSubmap {
+ public:
+  OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id);
+
+  // Adds one image's points (local frame, obstacle flags set) to the cloud and the voxel map.
+  OccupancyUpdateStats Integrate(const CameraPoints& points, OccupancyIntegrator* integrator);
+  void AddDistance(double d) { metadata_.distance += d; }
+
+  // Inner nodes updated and the tree pruned; the open submap is left empty.
+  std::shared_ptr<const Submap> Finish();
+
+  const SubmapMetadata& metadata() const { return metadata_; }
+  const VoxelCloud& cloud() const { return cloud_; }
+  const octomap::OcTree& tree() const { return *tree_; }
+
+ private:
+  SubmapMetadata metadata_;
+  VoxelCloud cloud_;
+  std::unique_ptr<octomap::OcTree> tree_;
+};
+
+}  // namespace cairn

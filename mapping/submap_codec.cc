@@ -1,0 +1,298 @@
+#include "mapping/submap_codec.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "drivers/mcap/byte_reader.h"
+#include "drivers/mcap/byte_writer.h"
+#include "drivers/mcap/crc32.h"
+
+namespace cairn {
+namespace {
+
+constexpr char kMagic[8] = {'C', 'A', 'I', 'R', 'N', 'S', 'U', 'B'};
+constexpr uint64_t kMaxPayload = uint64_t{1} << 30;
+constexpr int kOffsetSteps = 16;
+constexpr int kTreeDepth = 16;
+
+void F64(ByteWriter& w, double v) { w.U64(std::bit_cast<uint64_t>(v)); }
+double F64(ByteReader& r) { return std::bit_cast<double>(r.U64()); }
+
+void Varint(std::vector<uint8_t>& out, uint64_t v) {
+  while (v >= 0x80) {
+    out.push_back(static_cast<uint8_t>(v | 0x80));
+    v >>= 7;
+  }
+  out.push_back(static_cast<uint8_t>(v));
+}
+bool Varint(ByteReader& r, uint64_t* v) {
+  *v = 0;
+  for (int shift = 0; shift < 64; shift += 7) {
+    const uint8_t b = r.U8();
+    if (r.failed()) return false;
+    *v |= static_cast<uint64_t>(b & 0x7F) << shift;
+    if (!(b & 0x80)) return true;
+  }
+  return false;
+}
+
+// Binary occupancy data of a maximum-likelihood, pruned copy (the submap itself stays untouched).
+std::string TreeBinary(const octomap::OcTree& tree) {
+  octomap::OcTree copy(tree);
+  copy.toMaxLikelihood();
+  copy.prune();
+  std::ostringstream s;
+  copy.writeBinaryData(s);
+  return s.str();
+}
+
+Status CheckOptions(const SubmapOptions& o) {
+  const auto bad = [](double v, double lo, double hi) { return !(v >= lo && v <= hi); };
+  if (bad(o.cloud_resolution, 0.001, 10.0) || bad(o.octree_resolution, 0.001, 10.0)) {
+    return DataLossError("submap resolutions out of range");
+  }
+  if (bad(o.log_odds_hit, 0.0, 100.0) || bad(o.log_odds_miss, -100.0, 0.0) ||
+      bad(o.log_odds_min, -100.0, 0.0) || bad(o.log_odds_max, 0.0, 100.0)) {
+    return DataLossError("submap log-odds parameters out of range");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status SubmapCodec::ValidateOctreeBinary(std::span<const uint8_t> data) {
+  // Iterative walk: (depth of the node's children) per pending inner node, in stream order.
+  std::vector<int> pending;
+  size_t pos = 0;
+  if (data.empty()) return Status::Ok();  // empty tree
+  pending.push_back(1);
+  while (!pending.empty()) {
+    const int child_depth = pending.back();
+    pending.pop_back();
+    if (pos + 2 > data.size()) return DataLossError("octree data ends inside a node at byte " + std::to_string(pos));
+    const uint16_t bits = static_cast<uint16_t>(data[pos] | (data[pos + 1] << 8));
+    pos += 2;
+    int inner = 0;
+    for (int i = 0; i < 8; ++i) inner += ((bits >> (2 * i)) & 3) == 3;
+    if (inner > 0 && child_depth >= kTreeDepth) {
+      return DataLossError("octree node at byte " + std::to_string(pos - 2) + " has children below the finest level");
+    }
+    // Children are read depth-first in order: push in reverse so the first is processed next.
+    for (int i = 0; i < inner; ++i) pending.push_back(child_depth + 1);
+  }
+  if (pos != data.size()) {
+    return DataLossError("octree data has " + std::to_string(data.size() - pos) + " trailing bytes");
+  }
+  return Status::Ok();
+}
+
+Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, McapCompression compression) {
+  const SubmapMetadata& m = submap.metadata();
+  if (m.robot.size() > 255) return InvalidArgumentError("submap robot name longer than 255 bytes");
+  ByteWriter w;
+  w.U8(static_cast<uint8_t>(m.robot.size()));
+  w.Bytes(std::span(reinterpret_cast<const uint8_t*>(m.robot.data()), m.robot.size()));
+  w.U64(m.id);
+  w.U64(static_cast<uint64_t>(m.start.nanoseconds()));
+  w.U64(static_cast<uint64_t>(m.end.nanoseconds()));
+  w.U32(m.images);
+  F64(w, m.distance);
+  F64(w, m.options.cloud_resolution);
+  F64(w, m.options.octree_resolution);
+  F64(w, m.options.log_odds_hit);
+  F64(w, m.options.log_odds_miss);
+  F64(w, m.options.log_odds_min);
+  F64(w, m.options.log_odds_max);
+
+  // Cloud: voxel index and in-voxel offset of every point, sorted by index.
+  const std::vector<CloudPoint>& pts = submap.points();
+  const double res = m.options.cloud_resolution;
+  struct Q {
+    uint64_t linear;
+    uint8_t off[3];
+    const CloudPoint* p;
+  };
+  Eigen::Vector3i lo = Eigen::Vector3i::Constant(INT32_MAX), hi = Eigen::Vector3i::Constant(INT32_MIN);
+  std::vector<Eigen::Vector3i> cells(pts.size());
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector3d c = (pts[i].p.cast<double>() / res).array().floor();
+    if (!(c.array().abs() < 1e9).all()) return InvalidArgumentError("submap point not finite or too far away");
+    cells[i] = c.cast<int>();
+    lo = lo.cwiseMin(cells[i]);
+    hi = hi.cwiseMax(cells[i]);
+  }
+  const Eigen::Vector3i extent = pts.empty() ? Eigen::Vector3i::Zero() : Eigen::Vector3i(hi - lo + Eigen::Vector3i::Ones());
+  if ((extent.cast<double>().prod()) > 1e18) return InvalidArgumentError("submap cloud extent too large");
+  std::vector<Q> q(pts.size());
+  bool color = false;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector3i d = cells[i] - lo;
+    q[i].linear = (static_cast<uint64_t>(d.z()) * static_cast<uint64_t>(extent.y()) + static_cast<uint64_t>(d.y())) *
+                      static_cast<uint64_t>(extent.x()) + static_cast<uint64_t>(d.x());
+    for (int a = 0; a < 3; ++a) {
+      const double f = pts[i].p[a] / res - cells[i][a];
+      q[i].off[a] = static_cast<uint8_t>(std::clamp(static_cast<int>(f * kOffsetSteps), 0, kOffsetSteps - 1));
+    }
+    q[i].p = &pts[i];
+    color |= pts[i].r != pts[i].g || pts[i].r != pts[i].b;
+  }
+  std::sort(q.begin(), q.end(), [](const Q& a, const Q& b) { return a.linear < b.linear; });
+  w.U32(static_cast<uint32_t>(q.size()));
+  w.U8(color ? 1 : 0);
+  for (int a = 0; a < 3; ++a) w.U32(static_cast<uint32_t>(lo[a]));
+  for (int a = 0; a < 3; ++a) w.U32(static_cast<uint32_t>(extent[a]));
+  std::vector<uint8_t> stream;
+  uint64_t prev = 0;
+  for (size_t i = 0; i < q.size(); ++i) {
+    Varint(stream, i == 0 ? q[i].linear : q[i].linear - prev);
+    prev = q[i].linear;
+  }
+  w.U32(static_cast<uint32_t>(stream.size()));
+  w.Bytes(stream);
+  // Separate streams per field compress far better than interleaved records.
+  for (const Q& e : q) w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << 4)));
+  for (const Q& e : q) w.U8(e.off[2]);
+  for (const Q& e : q) w.U8(e.p->r);
+  if (color) {
+    for (const Q& e : q) w.U8(e.p->g);
+    for (const Q& e : q) w.U8(e.p->b);
+  }
+  std::vector<uint8_t> bits((q.size() + 7) / 8, 0);
+  for (size_t i = 0; i < q.size(); ++i) {
+    if (q[i].p->obstacle) bits[i / 8] |= static_cast<uint8_t>(1u << (i % 8));
+  }
+  w.Bytes(bits);
+  const std::string tree = TreeBinary(submap.tree());
+  w.U64(tree.size());
+  w.Bytes(std::span(reinterpret_cast<const uint8_t*>(tree.data()), tree.size()));
+
+  std::vector<uint8_t> compressed;
+  CAIRN_RETURN_IF_ERROR(ChunkCodec::Compress(compression, w.buffer(), &compressed));
+  ByteWriter out;
+  out.Bytes(std::span(reinterpret_cast<const uint8_t*>(kMagic), sizeof(kMagic)));
+  out.U16(kVersion);
+  out.U8(static_cast<uint8_t>(compression));
+  out.U8(0);
+  out.U64(w.size());
+  out.U64(compressed.size());
+  out.U32(Crc32::Of(w.buffer()));
+  out.U32(Crc32::Of(compressed));
+  out.Bytes(compressed);
+  return std::move(out.buffer());
+}
+
+Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint8_t> bytes) {
+  ByteReader h(bytes);
+  const auto magic = h.Take(sizeof(kMagic));
+  if (h.failed() || std::memcmp(magic.data(), kMagic, sizeof(kMagic)) != 0) {
+    return DataLossError("not a cairn submap (bad magic)");
+  }
+  const uint16_t version = h.U16();
+  const uint8_t compression = h.U8();
+  const uint8_t reserved = h.U8();
+  const uint64_t raw_size = h.U64();
+  const uint64_t packed_size = h.U64();
+  const uint32_t raw_crc = h.U32();
+  const uint32_t packed_crc = h.U32();
+  if (h.failed()) return DataLossError("submap header truncated");
+  if (version != kVersion) return DataLossError("submap format version " + std::to_string(version) + " is not supported (expected " + std::to_string(kVersion) + ")");
+  if (reserved != 0) return DataLossError("submap header reserved byte is " + std::to_string(reserved));
+  if (compression > static_cast<uint8_t>(McapCompression::kLz4)) return DataLossError("submap has unknown compression " + std::to_string(compression));
+  if (raw_size > kMaxPayload) return DataLossError("submap payload size " + std::to_string(raw_size) + " is implausible");
+  if (packed_size != h.remaining()) {
+    return DataLossError("submap body is " + std::to_string(h.remaining()) + " bytes, header says " + std::to_string(packed_size));
+  }
+  const auto packed = h.Take(packed_size);
+  if (Crc32::Of(packed) != packed_crc) return DataLossError("submap checksum mismatch (compressed body)");
+  std::vector<uint8_t> raw;
+  const Status st = ChunkCodec::Decompress(static_cast<McapCompression>(compression), packed, raw_size, &raw);
+  if (!st.ok()) return DataLossError("submap body does not decompress: " + st.message());
+  if (Crc32::Of(raw) != raw_crc) return DataLossError("submap checksum mismatch (payload)");
+
+  ByteReader r(raw);
+  SubmapMetadata m;
+  const auto name = r.Take(r.U8());
+  m.robot.assign(name.begin(), name.end());
+  m.id = r.U64();
+  m.start = Timestamp::FromNanoseconds(static_cast<int64_t>(r.U64()));
+  m.end = Timestamp::FromNanoseconds(static_cast<int64_t>(r.U64()));
+  m.images = r.U32();
+  m.distance = F64(r);
+  m.options.cloud_resolution = F64(r);
+  m.options.octree_resolution = F64(r);
+  m.options.log_odds_hit = F64(r);
+  m.options.log_odds_miss = F64(r);
+  m.options.log_odds_min = F64(r);
+  m.options.log_odds_max = F64(r);
+  if (r.failed()) return DataLossError("submap metadata truncated");
+  if (!(m.distance >= 0.0 && std::isfinite(m.distance))) return DataLossError("submap distance is invalid");
+  CAIRN_RETURN_IF_ERROR(CheckOptions(m.options));
+
+  const uint32_t n = r.U32();
+  const uint8_t color = r.U8();
+  Eigen::Vector3i lo, extent;
+  for (int a = 0; a < 3; ++a) lo[a] = static_cast<int32_t>(r.U32());
+  for (int a = 0; a < 3; ++a) extent[a] = static_cast<int32_t>(r.U32());
+  if (r.failed()) return DataLossError("submap cloud header truncated");
+  if (color > 1) return DataLossError("submap cloud colour flag is " + std::to_string(color));
+  const uint64_t per_point = color ? 5 : 3;
+  if (static_cast<uint64_t>(n) * per_point > r.remaining()) return DataLossError("submap cloud count " + std::to_string(n) + " exceeds the data");
+  if (n > 0 && (extent.minCoeff() <= 0 || extent.cast<double>().prod() > 1e18)) return DataLossError("submap cloud extent is invalid");
+  ByteReader keys(r.Take(r.U32()));
+  const auto xy = r.Take(n), z = r.Take(n), c0 = r.Take(n);
+  const auto c1 = color ? r.Take(n) : c0, c2 = color ? r.Take(n) : c0;
+  const auto bits = r.Take((static_cast<uint64_t>(n) + 7) / 8);
+  if (r.failed()) return DataLossError("submap cloud streams truncated");
+  const uint64_t cells = static_cast<uint64_t>(extent.x()) * static_cast<uint64_t>(extent.y()) * static_cast<uint64_t>(extent.z());
+  std::vector<CloudPoint> pts(n);
+  const double res = m.options.cloud_resolution;
+  uint64_t linear = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    uint64_t d;
+    if (!Varint(keys, &d)) return DataLossError("submap point " + std::to_string(i) + ": voxel index stream truncated");
+    if (i > 0 && d == 0) return DataLossError("submap point " + std::to_string(i) + ": duplicate voxel");
+    linear += d;
+    if (linear >= cells || linear < d) return DataLossError("submap point " + std::to_string(i) + ": voxel index outside the extent");
+    if ((xy[i] & 0xF) >= kOffsetSteps || z[i] >= kOffsetSteps) return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
+    const int64_t x = static_cast<int64_t>(linear % static_cast<uint64_t>(extent.x()));
+    const int64_t y = static_cast<int64_t>((linear / static_cast<uint64_t>(extent.x())) % static_cast<uint64_t>(extent.y()));
+    const int64_t zz = static_cast<int64_t>(linear / (static_cast<uint64_t>(extent.x()) * static_cast<uint64_t>(extent.y())));
+    const double off[3] = {(xy[i] & 0xF) + 0.5, (xy[i] >> 4) + 0.5, z[i] + 0.5};
+    CloudPoint& p = pts[i];
+    p.p = Eigen::Vector3f(static_cast<float>((lo.x() + x + off[0] / kOffsetSteps) * res),
+                          static_cast<float>((lo.y() + y + off[1] / kOffsetSteps) * res),
+                          static_cast<float>((lo.z() + zz + off[2] / kOffsetSteps) * res));
+    p.r = c0[i];
+    p.g = c1[i];
+    p.b = c2[i];
+    p.obstacle = (bits[i / 8] >> (i % 8)) & 1;
+  }
+  if (keys.remaining() != 0) return DataLossError("submap voxel index stream has trailing bytes");
+  const uint64_t tree_size = r.U64();
+  if (r.failed() || tree_size != r.remaining()) return DataLossError("submap octree size does not match the data");
+  const auto tree_bytes = r.Take(tree_size);
+  CAIRN_RETURN_IF_ERROR(ValidateOctreeBinary(tree_bytes).WithContext("submap octree"));
+  auto tree = MakeOccupancyTree(m.options);
+  if (!tree_bytes.empty()) {
+    std::istringstream s(std::string(reinterpret_cast<const char*>(tree_bytes.data()), tree_bytes.size()));
+    tree->readBinaryData(s);
+    if (!s) return DataLossError("submap octree does not parse");
+  }
+  return std::make_shared<const Submap>(std::move(m), std::move(pts), std::move(tree));
+}
+
+Expected<std::shared_ptr<const Submap>> SubmapCodec::ReadFile(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return NotFoundError("cannot open submap " + path);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  auto s = Decode(bytes);
+  if (!s.ok()) return s.status().WithContext(path);
+  return s;
+}
+
+}  // namespace cairn

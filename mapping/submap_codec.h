@@ -1,0 +1,40 @@
+#pragma once
+// Compact wire format of a finished submap (thesis 5.2.1): metadata, the point cloud quantized to
+// its voxel grid (sorted voxel indices as varint deltas plus a 4-bit centroid offset per axis,
+// i.e. resolution / 16 steps), intensity or colour, obstacle bits, and the occupancy tree in
+// OctoMap's binary format (maximum-likelihood free/occupied leaves, pruned), all compressed
+// (zstd or LZ4) and protected by CRC-32s of the compressed and the uncompressed bytes.
+//
+// Lossy by design: points move by at most resolution / 32 per axis, and the tree keeps only the
+// free/occupied state of each leaf (loaded as the clamping bounds, as OctoMap's .bt does).
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drivers/mcap/chunk_codec.h"
+#include "hal/status.h"
+#include "mapping/submap.h"
+
+namespace cairn {
+
+class SubmapCodec {
+ public:
+  static constexpr uint16_t kVersion = 1;
+
+  static Expected<std::vector<uint8_t>> Encode(const Submap& submap,
+                                               McapCompression compression = McapCompression::kZstd);
+  // Validates everything (magic, version, sizes, checksums, every field and the tree structure)
+  // and names the first problem.
+  static Expected<std::shared_ptr<const Submap>> Decode(std::span<const uint8_t> bytes);
+
+  // Reads and decodes a file; errors name it. (Writers use Encode and their own atomic write.)
+  static Expected<std::shared_ptr<const Submap>> ReadFile(const std::string& path);
+
+  // Checks that `data` is one complete OctoMap binary node stream of a tree of depth 16.
+  static Status ValidateOctreeBinary(std::span<const uint8_t> data);
+};
+
+}  // namespace cairn

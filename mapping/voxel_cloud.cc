@@ -1,0 +1,105 @@
+#include "mapping/voxel_cloud.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn {
+
+VoxelCloud::VoxelCloud(double resolution, size_t expected_voxels)
+    : res_(resolution), inv_res_(static_cast<float>(1.0 / resolution)), voxels_(expected_voxels) {}
+
+size_t VoxelCloud::size() const {
+  size_t n = 0;
+  voxels_.ForEach([&](uint64_t, const Accum& a) { n += a.n > 0; });
+  return n;
+}
+
+bool VoxelCloud::Add(const Eigen::Vector3f& p, uint8_t r, uint8_t g, uint8_t b, bool obstacle, int32_t weight) {
+  uint64_t key;
+  if (!VoxelKey::Of(p, inv_res_, &key)) return false;
+  const Eigen::Vector3f corner = VoxelKey::Unpack(key).cast<float>() * static_cast<float>(res_);
+  Accum& a = voxels_[key];
+  const float w = static_cast<float>(weight);
+  a.sx += w * (p.x() - corner.x());
+  a.sy += w * (p.y() - corner.y());
+  a.sz += w * (p.z() - corner.z());
+  a.n += weight;
+  a.sr += weight * r;
+  a.sg += weight * g;
+  a.sb += weight * b;
+  a.obstacles += obstacle ? weight : 0;
+  return true;
+}
+
+size_t VoxelCloud::AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
+                            const std::vector<uint8_t>& obstacle) {
+  size_t dropped = 0;
+  uint64_t run_key = VoxelKey::kEmpty;
+  Accum run;
+  Eigen::Vector3f corner = Eigen::Vector3f::Zero();
+  const auto flush = [&] {
+    if (run_key != VoxelKey::kEmpty) voxels_[run_key].Merge(run);
+  };
+  for (size_t i = 0; i < p.size(); ++i) {
+    uint64_t key;
+    if (!VoxelKey::Of(p[i], inv_res_, &key)) {
+      ++dropped;
+      continue;
+    }
+    if (key != run_key) {
+      flush();
+      run_key = key;
+      run = Accum{};
+      corner = VoxelKey::Unpack(key).cast<float>() * static_cast<float>(res_);
+    }
+    const Eigen::Vector3f d = p[i] - corner;
+    run.sx += d.x();
+    run.sy += d.y();
+    run.sz += d.z();
+    ++run.n;
+    run.sr += gray[i];
+    run.sg += gray[i];
+    run.sb += gray[i];
+    run.obstacles += obstacle[i] != 0;
+  }
+  flush();
+  return dropped;
+}
+
+CloudPoint VoxelCloud::Centroid(uint64_t key, const Accum& a) const {
+  const float inv_n = 1.0f / static_cast<float>(a.n);
+  const float res = static_cast<float>(res_);
+  const Eigen::Vector3f corner = VoxelKey::Unpack(key).cast<float>() * res;
+  // Keep the centroid inside its voxel despite float rounding of the sums.
+  const auto in = [&](float s) { return std::clamp(s * inv_n, 0.0f, res * 0.999f); };
+  CloudPoint c;
+  c.p = corner + Eigen::Vector3f(in(a.sx), in(a.sy), in(a.sz));
+  c.r = static_cast<uint8_t>((a.sr + a.n / 2) / a.n);
+  c.g = static_cast<uint8_t>((a.sg + a.n / 2) / a.n);
+  c.b = static_cast<uint8_t>((a.sb + a.n / 2) / a.n);
+  c.obstacle = a.obstacles > 0;
+  return c;
+}
+
+std::vector<CloudPoint> VoxelCloud::Points() const {
+  std::vector<CloudPoint> out;
+  out.reserve(voxels_.size());
+  ForEachPoint([&](const CloudPoint& c) { out.push_back(c); });
+  return out;
+}
+
+std::vector<CloudPoint> VoxelCloud::MergedPoints(const VoxelCloud& other) const {
+  std::vector<CloudPoint> out;
+  out.reserve(voxels_.size() + other.voxels_.size());
+  voxels_.ForEach([&](uint64_t key, const Accum& a) {
+    Accum m = a;
+    if (const Accum* o = other.voxels_.Find(key)) m.Merge(*o);
+    if (m.n > 0) out.push_back(Centroid(key, m));
+  });
+  other.voxels_.ForEach([&](uint64_t key, const Accum& o) {
+    if (o.n > 0 && voxels_.Find(key) == nullptr) out.push_back(Centroid(key, o));
+  });
+  return out;
+}
+
+}  // namespace cairn

@@ -1,0 +1,70 @@
+#pragma once
+// Point cloud with voxel-centroid filtering (thesis 5.1.2): every voxel keeps the running sum of
+// its points, so its point is the centroid of all points that fell into it, and it is an obstacle
+// if any of them was. Sums are kept relative to the voxel corner so float stays exact enough far
+// from the origin, and weights may be negative so a composed map can take a submap back out.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mapping/voxel_hash_map.h"
+
+namespace cairn {
+
+struct CloudPoint {
+  Eigen::Vector3f p = Eigen::Vector3f::Zero();
+  uint8_t r = 0, g = 0, b = 0;
+  uint8_t obstacle = 0;
+};
+
+class VoxelCloud {
+ public:
+  explicit VoxelCloud(double resolution = 0.05, size_t expected_voxels = 1024);
+
+  double resolution() const { return res_; }
+  // Voxels holding points (weight > 0).
+  size_t size() const;
+  void Clear() { voxels_.Clear(); }
+
+  // Adds `weight` copies of a point (negative weights remove what an earlier call added).
+  // Returns false for points outside the key range.
+  bool Add(const Eigen::Vector3f& p, uint8_t r, uint8_t g, uint8_t b, bool obstacle, int32_t weight = 1);
+  bool Add(const CloudPoint& c, int32_t weight = 1) { return Add(c.p, c.r, c.g, c.b, c.obstacle != 0, weight); }
+  // Gray points of one image: runs of neighbouring pixels in the same voxel are summed before one
+  // hash lookup per run (at 0.05 m a voxel spans many pixels of a row). Returns points dropped.
+  size_t AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
+                  const std::vector<uint8_t>& obstacle);
+
+  // Centroids, in key order of the hash table (not sorted).
+  std::vector<CloudPoint> Points() const;
+  // Centroids of this cloud and `other` together (same resolution), without changing either.
+  std::vector<CloudPoint> MergedPoints(const VoxelCloud& other) const;
+  template <class F>
+  void ForEachPoint(F&& f) const {
+    voxels_.ForEach([&](uint64_t key, const Accum& a) {
+      if (a.n > 0) f(Centroid(key, a));
+    });
+  }
+
+ private:
+  struct Accum {
+    float sx = 0, sy = 0, sz = 0;  // offsets from the voxel corner
+    int32_t n = 0;
+    int32_t sr = 0, sg = 0, sb = 0;
+    int32_t obstacles = 0;
+    void Merge(const Accum& o) {
+      sx += o.sx; sy += o.sy; sz += o.sz;
+      n += o.n; sr += o.sr; sg += o.sg; sb += o.sb;
+      obstacles += o.obstacles;
+    }
+  };
+  CloudPoint Centroid(uint64_t key, const Accum& a) const;
+
+  double res_;
+  float inv_res_;
+  VoxelHashMap<Accum> voxels_;
+};
+
+}  // namespace cairn
