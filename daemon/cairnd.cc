@@ -12,7 +12,9 @@
 #include "daemon/pipeline.h"
 #include "daemon/run_summary.h"
 #include "daemon/systemd_notifier.h"
+#include "drivers/can_wheel_decoder.h"
 #include "drivers/euroc_replay.h"
+#include "estimation/trajectory.h"
 #include "drivers/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
 
@@ -99,6 +101,20 @@ int Cairnd::Run() {
   }
   const bool deterministic = options_.source == SourceKind::kReplay && options_.replay.deterministic;
   Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
+  if (dataset_) {
+    // The estimation chain needs the camera and IMU calibration the dataset carries.
+    EstimationSetup setup;
+    setup.imu = dataset_->imu_calibration();
+    setup.stereo = dataset_->stereo_calibration();
+    if (options_.can.enabled) setup.wheels = CanWheelDecoder(options_.can).calibration();
+    setup.filter = options_.filter;
+    setup.vo = options_.vo;
+    setup.frame_switch = options_.frame_switch;
+    if (Status s = pipeline.EnableEstimation(setup); !s.ok()) {
+      spdlog::error("{}: {}", options_.replay.dataset, s.ToString());
+      return 1;
+    }
+  }
   std::unique_ptr<TelemetryStage> telemetry;
   if (options_.recording.enabled || options_.live.enabled) {
     telemetry = std::make_unique<TelemetryStage>(options_.executors.telemetry,
@@ -212,6 +228,14 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
                                                                       config_path_ + ")\n" +
                                                                       OptionsYamlWriter::Write(options_)));
   CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/diagnostics.json", BuildDiagnosticsJson(run, pipeline)));
+  if (pipeline.trajectory() != nullptr) {
+    // Body pose per camera frame: the filter's, chained through its frame switches into the
+    // first local frame; and the raw odometry chain.
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/trajectory.tum",
+                                              TrajectoryIo::Format(*pipeline.trajectory(), TrajectoryFormat::kTum)));
+    CAIRN_RETURN_IF_ERROR(
+        WriteFileAtomically(dir + "/vo.tum", TrajectoryIo::Format(*pipeline.odometry(), TrajectoryFormat::kTum)));
+  }
   // Last: its presence means the run's outputs are complete.
   return WriteFileAtomically(dir + "/summary.json", BuildSummaryJson(run, pipeline));
 }

@@ -10,6 +10,8 @@
 #include "daemon/recording_options.h"
 #include "drivers/can_wheel_options.h"
 #include "drivers/replay_options.h"
+#include "estimation/filter_options.h"
+#include "estimation/vo_options.h"
 #include "hal/options_visitor.h"
 
 namespace cairn {
@@ -66,6 +68,9 @@ struct CairndOptions {
   OutputOptions output;
   RecordingOptions recording;
   LiveStreamOptions live;
+  FilterOptions filter;
+  VoOptions vo;
+  FrameSwitchOptions frame_switch;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -78,6 +83,9 @@ struct CairndOptions {
     v.Section("output", output);
     v.Section("recording", recording);
     v.Section("live", live);
+    v.Section("filter", filter);
+    v.Section("vo", vo);
+    v.Section("frame_switch", frame_switch);
   }
 };
 

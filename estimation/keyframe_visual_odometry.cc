@@ -23,6 +23,17 @@ KeyframeVisualOdometry::KeyframeVisualOdometry(const VoOptions& options, const R
   keyframes_.reserve(static_cast<size_t>(options.keyframes) + 1);
 }
 
+void KeyframeVisualOdometry::DropKeyframe(Timestamp time) {
+  for (size_t i = 0; i < keyframes_.size(); ++i) {
+    if (keyframes_[i].time != time) continue;
+    // Keep its buffers for the next frames.
+    std::swap(current_.left_pyramid, keyframes_[i].pair.left_pyramid);
+    std::swap(current_.right_pyramid, keyframes_[i].pair.right_pyramid);
+    keyframes_.erase(keyframes_.begin() + static_cast<std::ptrdiff_t>(i));
+    return;
+  }
+}
+
 bool KeyframeVisualOdometry::ExposureOk(const cv::Mat& image) const {
   // Every 4th pixel of every 4th row is plenty to tell a usable image from a blank one.
   double sum = 0.0, sum2 = 0.0;

@@ -58,6 +58,9 @@ class KeyframeVisualOdometry {
   VoResult Process(Timestamp time, const cv::Mat& left, const cv::Mat& right);
   // The camera lost `count` frames before the next one: reported as failures, no state change.
   void ReportDropped(int count) { consecutive_failures_ += count; }
+  // Stops using the keyframe taken at `time` (its filter clone is gone). With no keyframe left
+  // the next usable frame starts a new one.
+  void DropKeyframe(Timestamp time);
 
   int keyframe_count() const { return static_cast<int>(keyframes_.size()); }
   const RectifiedStereoCamera& camera() const { return camera_; }
