@@ -25,6 +25,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"bench graph", "online SLAM graph on thesis-sized multi-robot graphs: update and covariance times", RunBenchGraph},
     {"sim", "simulate a multi-robot mission into EuRoC/ASL folders and CAN logs", RunSim},
     {"bench sim", "time rendering a stereo pair of the simulator's default world", RunBenchSim},
+    {"eval", "trajectory accuracy vs ground truth (TUM/EuRoC): ATE, RPE, drift as JSON", RunEval},
+    {"bench vo", "visual-odometry time per stereo frame on an EuRoC/ASL folder (no SGM)", RunBenchVo},
 });
 
 void PrintHelp() {

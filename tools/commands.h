@@ -25,3 +25,10 @@ int RunSim(const CommandArgs& args);
 int RunBenchSim(const CommandArgs& args);
 
 }  // namespace cairn::tools
+
+namespace cairn::tools {
+
+int RunEval(const CommandArgs& args);
+int RunBenchVo(const CommandArgs& args);
+
+}  // namespace cairn::tools
