@@ -24,13 +24,8 @@ KeyframeVisualOdometry::KeyframeVisualOdometry(const VoOptions& options, const R
 }
 
 void KeyframeVisualOdometry::DropKeyframe(Timestamp time) {
-  for (size_t i = 0; i < keyframes_.size(); ++i) {
-    if (keyframes_[i].time != time) continue;
-    // Keep its buffers for the next frames.
-    std::swap(current_.left_pyramid, keyframes_[i].pair.left_pyramid);
-    std::swap(current_.right_pyramid, keyframes_[i].pair.right_pyramid);
-    keyframes_.erase(keyframes_.begin() + static_cast<std::ptrdiff_t>(i));
-    return;
+  for (Keyframe& k : keyframes_) {
+    if (k.time == time) k.referable = false;
   }
 }
 
@@ -88,7 +83,8 @@ bool KeyframeVisualOdometry::AddKeyframe(Timestamp time, const Eigen::Isometry3d
     size_t victim = 0;
     double worst = -1.0;
     for (size_t i = 0; i < keyframes_.size(); ++i) {
-      const double d = Distance(keyframes_[i].T_odom_cam, T_odom_cam);
+      // Keyframes without a filter clone go first.
+      const double d = Distance(keyframes_[i].T_odom_cam, T_odom_cam) + (keyframes_[i].referable ? 0.0 : 1e6);
       if (d > worst) {
         worst = d;
         victim = i;
@@ -201,8 +197,9 @@ VoResult KeyframeVisualOdometry::Process(Timestamp time, const cv::Mat& left, co
   size_t best = 0;
   double best_d = 1e300;
   for (size_t i = 0; i < keyframes_.size(); ++i) {
-    const double d = Distance(keyframes_[i].T_odom_cam, T_odom_pred);
-    // Strictly nearer only: among equally near keyframes the oldest (least drift) wins.
+    // Referable keyframes first; among them strictly nearer only, so that among equally near
+    // keyframes the oldest (least drift) wins.
+    const double d = Distance(keyframes_[i].T_odom_cam, T_odom_pred) + (keyframes_[i].referable ? 0.0 : 1e6);
     if (d < best_d - 1e-9) {
       best_d = d;
       best = i;
@@ -236,6 +233,13 @@ VoResult KeyframeVisualOdometry::Process(Timestamp time, const cv::Mat& left, co
   r.covariance = 0.5 * (r.covariance + r.covariance.transpose()).eval();
   r.keyframe_time = kf->time;
   r.status = VoStatus::kOk;
+  if (!kf->referable) {
+    // Tracked for the chain only: no delta pose for the filter; this frame becomes a keyframe.
+    r.status = VoStatus::kNoKeyframe;
+    AddKeyframe(time, T_odom_cam_, &r);
+    Finish(&r);
+    return r;
+  }
 
   const double tracked_ratio = static_cast<double>(e.inliers) / static_cast<double>(std::max<size_t>(1, kf->points.size()));
   if (tracked_ratio < options_.keyframe_min_tracked_ratio ||

@@ -58,8 +58,9 @@ class KeyframeVisualOdometry {
   VoResult Process(Timestamp time, const cv::Mat& left, const cv::Mat& right);
   // The camera lost `count` frames before the next one: reported as failures, no state change.
   void ReportDropped(int count) { consecutive_failures_ += count; }
-  // Stops using the keyframe taken at `time` (its filter clone is gone). With no keyframe left
-  // the next usable frame starts a new one.
+  // The keyframe taken at `time` has no filter clone (gone, or taken before the filter ran): it
+  // is no longer a reference for delta poses. It still serves to track the next frame, which
+  // then becomes a keyframe, so the odometry chain continues.
   void DropKeyframe(Timestamp time);
 
   int keyframe_count() const { return static_cast<int>(keyframes_.size()); }
@@ -72,6 +73,7 @@ class KeyframeVisualOdometry {
     std::vector<cv::Point2f> left_px;
     std::vector<StereoPoint> points;  // in the keyframe camera
     Eigen::Isometry3d T_odom_cam = Eigen::Isometry3d::Identity();
+    bool referable = true;  // false once its filter clone is known to be missing
   };
 
   bool ExposureOk(const cv::Mat& image) const;

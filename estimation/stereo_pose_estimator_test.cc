@@ -11,21 +11,13 @@
 #include <gtest/gtest.h>
 
 #include "estimation/so3.h"
+#include "estimation/vo_test_scene.h"
 #include "mapping/stereo_error_model.h"
 
 namespace cairn {
 namespace {
 
-RectifiedStereoCamera Camera() {
-  RectifiedStereoCamera c;
-  c.width = 752;
-  c.height = 480;
-  c.f = 450.0;
-  c.cx = 376.0;
-  c.cy = 240.0;
-  c.baseline = 0.11;
-  return c;
-}
+RectifiedStereoCamera Camera() { return testing::VoTestScene::EurocLikeCamera(); }
 
 StereoObservation Observe(const RectifiedStereoCamera& c, const Eigen::Vector3d& p) {
   return {c.f * p.x() / p.z() + c.cx, c.f * (p.x() - c.baseline) / p.z() + c.cx, c.f * p.y() / p.z() + c.cy};
