@@ -13,6 +13,7 @@
 #include "daemon/run_summary.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
+#include "drivers/can_wheel_decoder.h"
 #include "drivers/euroc_replay.h"
 #include "drivers/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
@@ -114,6 +115,22 @@ int Cairnd::Run() {
   // Replayed and simulated sources share the replay section's pacing.
   const bool deterministic = options_.source != SourceKind::kLive && options_.replay.deterministic;
   Pipeline pipeline(options_.executors, options_.queues, rates, deterministic);
+  if (stereo_calibration_ && imu_calibration_) {
+    // The estimation chain needs the camera and IMU calibration the dataset or simulator carries.
+    EstimationSetup setup;
+    setup.imu = *imu_calibration_;
+    setup.stereo = *stereo_calibration_;
+    // A simulated rover's wheels speak the configured CAN layout too.
+    const bool wheels = options_.can.enabled || (options_.source == SourceKind::kSim && options_.robot.kind == RobotKind::kRover);
+    if (wheels) setup.wheels = CanWheelDecoder(options_.can).calibration();
+    setup.filter = options_.filter;
+    setup.vo = options_.vo;
+    setup.frame_switch = options_.frame_switch;
+    if (Status s = pipeline.EnableEstimation(setup); !s.ok()) {
+      spdlog::error("{}: {}", options_.source == SourceKind::kSim ? "sim" : options_.replay.dataset, s.ToString());
+      return 1;
+    }
+  }
   std::unique_ptr<TelemetryStage> telemetry;
   if (options_.recording.enabled || options_.live.enabled) {
     telemetry = std::make_unique<TelemetryStage>(options_.executors.telemetry,
@@ -230,6 +247,14 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
   if (ground_truth_) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/ground_truth.tum",
                                               TrajectoryIo::Format(*ground_truth_, TrajectoryFormat::kTum)));
+  }
+  if (pipeline.trajectory() != nullptr) {
+    // Body pose per camera frame: the filter's, chained through its frame switches into the
+    // first local frame; and the raw odometry chain.
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/trajectory.tum",
+                                              TrajectoryIo::Format(*pipeline.trajectory(), TrajectoryFormat::kTum)));
+    CAIRN_RETURN_IF_ERROR(
+        WriteFileAtomically(dir + "/vo.tum", TrajectoryIo::Format(*pipeline.odometry(), TrajectoryFormat::kTum)));
   }
   // Last: its presence means the run's outputs are complete.
   return WriteFileAtomically(dir + "/summary.json", BuildSummaryJson(run, pipeline));

@@ -11,6 +11,8 @@
 #include "daemon/sim_source_options.h"
 #include "drivers/can_wheel_options.h"
 #include "drivers/replay_options.h"
+#include "estimation/filter_options.h"
+#include "estimation/vo_options.h"
 #include "hal/options_visitor.h"
 
 namespace cairn {
@@ -68,6 +70,9 @@ struct CairndOptions {
   OutputOptions output;
   RecordingOptions recording;
   LiveStreamOptions live;
+  FilterOptions filter;
+  VoOptions vo;
+  FrameSwitchOptions frame_switch;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -82,6 +87,9 @@ struct CairndOptions {
     v.Section("output", output);
     v.Section("recording", recording);
     v.Section("live", live);
+    v.Section("filter", filter);
+    v.Section("vo", vo);
+    v.Section("frame_switch", frame_switch);
   }
 };
 

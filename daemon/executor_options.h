@@ -37,11 +37,13 @@ struct ExecutorOptions {
 struct ExecutorsOptions {
   ExecutorOptions estimation;  // the hard-real-time filter thread
   ExecutorOptions stereo;      // rectification, SGM, depth
+  ExecutorOptions vo;          // keyframe stereo visual odometry
   ExecutorOptions telemetry;   // recording (and later the live stream)
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
     v.Section("stereo", stereo);
+    v.Section("vo", vo);
     v.Section("telemetry", telemetry);
   }
 };
@@ -51,6 +53,8 @@ struct QueueOptions {
   int64_t imu = 2048;
   int64_t wheel_odometry = 512;
   int64_t stereo = 4;
+  // Rectified pairs waiting for the visual odometry.
+  int64_t vo = 4;
   // Samples waiting for the telemetry executor (recording, live stream); IMU gets 8x this.
   int64_t telemetry = 64;
 
@@ -58,6 +62,7 @@ struct QueueOptions {
     v.Integer("imu", imu, 2, 1 << 20, "samples");
     v.Integer("wheel_odometry", wheel_odometry, 2, 1 << 20, "samples");
     v.Integer("stereo", stereo, 2, 1024, "frames");
+    v.Integer("vo", vo, 2, 1024, "frames");
     v.Integer("telemetry", telemetry, 2, 1 << 20, "samples");
   }
 };

@@ -4,6 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <thread>
 
 namespace cairn {
@@ -20,9 +21,15 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       wheel_queue_(static_cast<size_t>(queues.wheel_odometry)),
       trigger_queue_(static_cast<size_t>(queues.wheel_odometry)),
       stereo_queue_(static_cast<size_t>(queues.stereo)),
+      rectified_queue_(static_cast<size_t>(queues.vo)),
+      clone_queue_(64),
+      vo_result_queue_(32),
+      switch_queue_(8),
+      estimate_queue_(256),
       imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
-      estimation_("estimation", executors.estimation),
+      estimation_exec_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
+      vo_("vo", executors.vo),
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
@@ -30,21 +37,48 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
 
 Pipeline::~Pipeline() { StopAndDrain(); }
 
+Status Pipeline::EnableEstimation(const EstimationSetup& setup) {
+  if (started_) return FailedPreconditionError("EnableEstimation() after Start()");
+  if (!setup.vo.enabled) return Status::Ok();
+  // Buffers for the pairs waiting in the queue, the one in the odometry and the one being written.
+  auto rectify = StereoRectifyStage::Create(setup.stereo, rectified_queue_.capacity() + 2);
+  if (!rectify.ok()) return rectify.status().WithContext("stereo calibration");
+  rectify_ = std::move(*rectify);
+  vo_stage_ = std::make_unique<VoStage>(setup.vo, setup.frame_switch, rectify_->camera(), rectify_->T_body_cam());
+  estimation_ = std::make_unique<EstimationStage>(setup.filter, setup.imu, setup.wheels, &estimate_queue_);
+  return Status::Ok();
+}
+
 void Pipeline::Start() {
   if (started_) return;
   started_ = true;
-  estimation_.Start([this](std::stop_token stop) { EstimationLoop(stop); });
+  estimation_exec_.Start([this](std::stop_token stop) { EstimationLoop(stop); });
   stereo_.Start([this](std::stop_token stop) { StereoLoop(stop); });
+  if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
 }
 
 void Pipeline::StopAndDrain() {
   if (!started_) return;
-  estimation_.RequestStop();
+  // Upstream first, so that every stage drains into a consumer that still runs (in deterministic
+  // mode a producer waits for its consumer).
   stereo_.RequestStop();
-  estimation_signal_.Notify();
   stereo_signal_.Notify();
-  estimation_.Join();
   stereo_.Join();
+  if (estimation_) {
+    vo_.RequestStop();
+    vo_signal_.Notify();
+    vo_.Join();
+  }
+  estimation_exec_.RequestStop();
+  estimation_signal_.Notify();
+  estimation_exec_.Join();
+  // Estimates emitted after the odometry stopped.
+  if (vo_stage_) {
+    while (const FrameEstimate* e = estimate_queue_.Front()) {
+      vo_stage_->OnEstimate(*e);
+      estimate_queue_.PopFront();
+    }
+  }
   started_ = false;
 }
 
@@ -85,41 +119,77 @@ void Pipeline::OnDeviceFault(const DeviceFault& fault) {
   spdlog::warn("device fault: {}: {}: {}", fault.device, DeviceFaultKindName(fault.kind), fault.detail);
 }
 
+void Pipeline::RequestFrameSwitch(const FrameSwitchRequest& request) {
+  Publish(switch_queue_, request, estimation_signal_);
+}
+
 void Pipeline::EstimationLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { estimation_signal_.Notify(); });
+  const auto time_of = [](const auto* q) { return q ? q->value : Timestamp::Max(); };
   while (true) {
     const uint32_t seen = estimation_signal_.sequence();
     bool worked = false;
-    // Consume the three inputs in timestamp order.
+    // Consume the inputs in timestamp order (ties: sensor data first).
     while (true) {
       const auto* imu = imu_queue_.Front();
       const auto* wheel = wheel_queue_.Front();
       const auto* trig = trigger_queue_.Front();
-      if (imu == nullptr && wheel == nullptr && trig == nullptr) break;
-      const Timestamp ti = imu ? imu->value.time : Timestamp::Max();
-      const Timestamp tw = wheel ? wheel->value.time : Timestamp::Max();
-      const Timestamp tt = trig ? trig->value.time : Timestamp::Max();
+      const auto* clone = clone_queue_.Front();
+      const auto* vo = vo_result_queue_.Front();
+      const auto* sw = switch_queue_.Front();
+      if (!imu && !wheel && !trig && !clone && !vo && !sw) break;
+      const Timestamp times[6] = {imu ? imu->value.time : Timestamp::Max(),
+                                  wheel ? wheel->value.time : Timestamp::Max(),
+                                  trig ? trig->value.time : Timestamp::Max(),
+                                  time_of(clone),
+                                  vo ? vo->value.time : Timestamp::Max(),
+                                  sw ? sw->value.time : Timestamp::Max()};
+      const void* fronts[6] = {imu, wheel, trig, clone, vo, sw};
+      int k = -1;
+      for (int i = 0; i < 6; ++i) {
+        if (fronts[i] != nullptr && (k < 0 || times[i] < times[k])) k = i;
+      }
       const int64_t now = MonotonicNs();
-      if (imu != nullptr && ti <= tw && ti <= tt) {
-        const Duration latency = Duration::Nanoseconds(now - imu->enqueued_ns);
-        imu_latency_.Record(latency);
-        if (latency > imu_deadline_) deadline_misses_.fetch_add(1, std::memory_order_relaxed);
-        imu_stats_.Add(ti);
-        if (telemetry_ != nullptr) telemetry_->OfferImu(imu->value);
-        imu_queue_.PopFront();
-      } else if (wheel != nullptr && tw <= tt) {
-        wheel_latency_.Record(Duration::Nanoseconds(now - wheel->enqueued_ns));
-        wheel_stats_.Add(tw);
-        if (telemetry_ != nullptr) telemetry_->OfferWheelOdometry(wheel->value);
-        wheel_queue_.PopFront();
-      } else {
-        trigger_stats_.Add(tt);
-        trigger_queue_.PopFront();
+      switch (k) {
+        case 0: {
+          const Duration latency = Duration::Nanoseconds(now - imu->enqueued_ns);
+          imu_latency_.Record(latency);
+          if (latency > imu_deadline_) deadline_misses_.fetch_add(1, std::memory_order_relaxed);
+          imu_stats_.Add(times[0]);
+          if (estimation_) estimation_->OnImu(imu->value);
+          if (telemetry_ != nullptr) telemetry_->OfferImu(imu->value);
+          imu_queue_.PopFront();
+          break;
+        }
+        case 1:
+          wheel_latency_.Record(Duration::Nanoseconds(now - wheel->enqueued_ns));
+          wheel_stats_.Add(times[1]);
+          if (estimation_) estimation_->OnWheel(wheel->value);
+          if (telemetry_ != nullptr) telemetry_->OfferWheelOdometry(wheel->value);
+          wheel_queue_.PopFront();
+          break;
+        case 2:
+          trigger_stats_.Add(times[2]);
+          trigger_queue_.PopFront();
+          break;
+        case 3:
+          estimation_->OnFrame(clone->value);
+          clone_queue_.PopFront();
+          break;
+        case 4:
+          estimation_->OnVoResult(vo->value);
+          vo_result_queue_.PopFront();
+          break;
+        default:
+          estimation_->OnFrameSwitch(sw->value);
+          switch_queue_.PopFront();
+          break;
       }
       worked = true;
       if (deterministic_) consumed_signal_.Notify();
     }
-    if (stop.stop_requested() && imu_queue_.empty() && wheel_queue_.empty() && trigger_queue_.empty()) {
+    if (stop.stop_requested() && imu_queue_.empty() && wheel_queue_.empty() && trigger_queue_.empty() &&
+        clone_queue_.empty() && vo_result_queue_.empty() && switch_queue_.empty()) {
       return;
     }
     if (!worked) estimation_signal_.WaitChange(seen);
@@ -128,6 +198,7 @@ void Pipeline::EstimationLoop(std::stop_token stop) {
 
 void Pipeline::StereoLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { stereo_signal_.Notify(); });
+  const MonotonicClock clock;
   while (true) {
     const uint32_t seen = stereo_signal_.sequence();
     bool worked = false;
@@ -135,7 +206,9 @@ void Pipeline::StereoLoop(std::stop_token stop) {
       stereo_latency_.Record(Duration::Nanoseconds(MonotonicNs() - queued->enqueued_ns));
       const StereoFrame* f = &queued->value;
       stereo_stats_.Add(f->time);
+      int gap = 0;
       if (stereo_stats_.count() > 1 && f->frame_counter > last_frame_counter_ + 1) {
+        gap = static_cast<int>(std::min<uint64_t>(f->frame_counter - last_frame_counter_ - 1, 1 << 20));
         stereo_report_.frame_counter_gaps += f->frame_counter - last_frame_counter_ - 1;
       }
       last_frame_counter_ = f->frame_counter;
@@ -145,6 +218,22 @@ void Pipeline::StereoLoop(std::stop_token stop) {
         stereo_report_.height = f->left.height;
       }
       if (telemetry_ != nullptr) telemetry_->OfferStereo(*f);
+      if (estimation_) {
+        // The filter clones its state at the exposure time now; the odometry's delta pose
+        // references that clone when it arrives.
+        Publish(clone_queue_, f->time, estimation_signal_);
+        const Timestamp start = clock.Now();
+        RectifiedPair pair;
+        pending_dropped_ += gap;
+        if (rectify_->Rectify(*f, &pair)) {
+          rectify_time_.Record(clock.Now() - start);
+          pair.dropped_before = pending_dropped_;
+          pending_dropped_ = 0;
+          Publish(rectified_queue_, pair, vo_signal_);
+        } else {
+          ++rectify_failures_;
+        }
+      }
       stereo_queue_.PopFront();
       worked = true;
       if (deterministic_) consumed_signal_.Notify();
@@ -154,17 +243,53 @@ void Pipeline::StereoLoop(std::stop_token stop) {
   }
 }
 
+void Pipeline::DrainEstimates() {
+  while (const FrameEstimate* e = estimate_queue_.Front()) {
+    const std::optional<FrameSwitchRequest> request = vo_stage_->OnEstimate(*e);
+    estimate_queue_.PopFront();
+    if (request) RequestFrameSwitch(*request);
+  }
+}
+
+void Pipeline::VoLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { vo_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = vo_signal_.sequence();
+    bool worked = false;
+    while (const auto* queued = rectified_queue_.Front()) {
+      // The filter's estimates are taken in right before each frame (a fixed point in the data
+      // flow, so deterministic replays switch frames at the same instants).
+      DrainEstimates();
+      const VoResult r = vo_stage_->Process(queued->value);
+      Publish(vo_result_queue_, r, estimation_signal_);
+      rectified_queue_.PopFront();
+      worked = true;
+      if (deterministic_) consumed_signal_.Notify();
+    }
+    if (stop.stop_requested() && rectified_queue_.empty()) return;
+    if (!worked) vo_signal_.WaitChange(seen);
+  }
+}
+
 std::vector<QueueReport> Pipeline::queue_reports() const {
   const auto r = [](const char* name, const auto& q) {
     return QueueReport{name, q.capacity(), q.pushed(), q.dropped(), q.high_water()};
   };
-  return {r("imu", imu_queue_), r("wheel_odometry", wheel_queue_), r("trigger", trigger_queue_),
-          r("stereo", stereo_queue_)};
+  std::vector<QueueReport> out = {r("imu", imu_queue_), r("wheel_odometry", wheel_queue_),
+                                  r("trigger", trigger_queue_), r("stereo", stereo_queue_)};
+  if (estimation_) {
+    for (QueueReport q : {r("vo", rectified_queue_), r("clone", clone_queue_), r("vo_result", vo_result_queue_),
+                          r("frame_switch", switch_queue_), r("estimate", estimate_queue_)}) {
+      out.push_back(q);
+    }
+  }
+  return out;
 }
 
 uint64_t Pipeline::total_dropped() const {
-  return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() +
-         stereo_queue_.dropped();
+  return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
+         rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
+         estimate_queue_.dropped();
 }
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {
@@ -175,7 +300,20 @@ std::vector<LatencyReport> Pipeline::latency_reports() const {
 }
 
 std::vector<ExecutorReport> Pipeline::executor_reports() const {
-  return {estimation_.report(), stereo_.report()};
+  if (estimation_) return {estimation_exec_.report(), stereo_.report(), vo_.report()};
+  return {estimation_exec_.report(), stereo_.report()};
+}
+
+std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
+  if (!vo_stage_) return {};
+  const auto r = [](const char* name, const LatencyHistogram& h) {
+    return StageTimingReport{name, h.count(), h.Quantile(0.5).seconds(), h.Quantile(0.99).seconds(), h.max().seconds()};
+  };
+  return {r("rectify", rectify_time_), r("vo", vo_stage_->vo_time())};
+}
+
+EstimationReport Pipeline::estimation_report() const {
+  return estimation_ ? estimation_->report() : EstimationReport{};
 }
 
 FaultReport Pipeline::fault_report() const {

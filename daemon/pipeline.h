@@ -12,12 +12,16 @@
 #include <string>
 #include <vector>
 
+#include "daemon/estimation_stage.h"
 #include "daemon/executor.h"
 #include "daemon/executor_options.h"
 #include "daemon/latency_histogram.h"
 #include "daemon/telemetry_stage.h"
 #include "daemon/sensor_stream_stats.h"
 #include "daemon/spsc_queue.h"
+#include "daemon/stereo_rectify_stage.h"
+#include "daemon/vo_stage.h"
+#include "hal/calibration.h"
 #include "hal/sensor_sink.h"
 
 namespace cairn {
@@ -56,6 +60,23 @@ struct StereoStageReport {
   uint64_t size_changes = 0;
 };
 
+// What the estimation chain (rectification -> visual odometry -> local reference filter) needs.
+struct EstimationSetup {
+  ImuCalibration imu;
+  StereoCalibration stereo;
+  WheelCalibration wheels;
+  FilterOptions filter;
+  VoOptions vo;
+  FrameSwitchOptions frame_switch;
+};
+
+// Per-stage processing time of the estimation chain (host dependent: diagnostics only).
+struct StageTimingReport {
+  std::string name;
+  uint64_t count = 0;
+  double p50 = 0.0, p99 = 0.0, max = 0.0;  // s
+};
+
 class Pipeline final : public SensorSink {
  public:
   Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues, PipelineRates rates,
@@ -65,6 +86,14 @@ class Pipeline final : public SensorSink {
   // Hands every consumed sample on to `telemetry` (which must outlive the pipeline's threads).
   // Call before Start().
   void SetTelemetry(TelemetryStage* telemetry) { telemetry_ = telemetry; }
+  // Runs the estimation chain on the data: stereo pairs are rectified (stereo executor), matched
+  // by the keyframe visual odometry (vo executor) and fused with IMU and wheel data by the local
+  // reference filter (estimation executor). Call before Start(). Without it the stages only
+  // collect statistics.
+  Status EnableEstimation(const EstimationSetup& setup);
+  // Asks the filter to switch its frame of reference (the path submap partitioning uses). From
+  // the vo thread (the placeholder policy) or, later, the mapping thread; one producer.
+  void RequestFrameSwitch(const FrameSwitchRequest& request);
   // Starts the stage threads.
   void Start();
   // Lets the stages consume what is queued, then joins them. Publishing must have stopped.
@@ -85,6 +114,14 @@ class Pipeline final : public SensorSink {
   std::vector<QueueReport> queue_reports() const;
   std::vector<ExecutorReport> executor_reports() const;
   std::vector<LatencyReport> latency_reports() const;
+  std::vector<StageTimingReport> stage_timing_reports() const;
+  bool estimation_enabled() const { return estimation_ != nullptr; }
+  // Valid after StopAndDrain() when estimation is enabled.
+  EstimationReport estimation_report() const;
+  const VoStageReport* vo_report() const { return vo_stage_ ? &vo_stage_->report() : nullptr; }
+  const Trajectory* trajectory() const { return vo_stage_ ? &vo_stage_->trajectory() : nullptr; }
+  const Trajectory* odometry() const { return vo_stage_ ? &vo_stage_->odometry() : nullptr; }
+  uint64_t rectify_failures() const { return rectify_failures_; }
   FaultReport fault_report() const;
 
   // Live progress (any thread).
@@ -104,6 +141,8 @@ class Pipeline final : public SensorSink {
   void Publish(SpscQueue<Queued<T>>& queue, const T& item, WorkSignal& signal);
   void EstimationLoop(std::stop_token stop);
   void StereoLoop(std::stop_token stop);
+  void VoLoop(std::stop_token stop);
+  void DrainEstimates();
 
   const bool deterministic_;
   WorkSignal estimation_signal_;
@@ -113,11 +152,20 @@ class Pipeline final : public SensorSink {
   SpscQueue<Queued<WheelOdometrySample>> wheel_queue_;
   SpscQueue<Queued<TriggerEvent>> trigger_queue_;
   SpscQueue<Queued<StereoFrame>> stereo_queue_;
+  // Estimation chain: stereo -> vo (rectified pairs), stereo -> estimation (clone at exposure),
+  // vo -> estimation (delta poses, frame-switch requests), estimation -> vo (estimates).
+  WorkSignal vo_signal_;
+  SpscQueue<Queued<RectifiedPair>> rectified_queue_;
+  SpscQueue<Queued<Timestamp>> clone_queue_;
+  SpscQueue<Queued<VoResult>> vo_result_queue_;
+  SpscQueue<Queued<FrameSwitchRequest>> switch_queue_;
+  SpscQueue<FrameEstimate> estimate_queue_;
   const Duration imu_deadline_;
   std::atomic<uint64_t> deadline_misses_{0};
 
-  Executor estimation_;
+  Executor estimation_exec_;
   Executor stereo_;
+  Executor vo_;
 
   // Owned by the estimation thread until joined.
   SensorStreamStats imu_stats_;
@@ -129,6 +177,14 @@ class Pipeline final : public SensorSink {
   SensorStreamStats stereo_stats_;
   StereoStageReport stereo_report_;
   uint64_t last_frame_counter_ = 0;
+
+  // Estimation chain (null when not enabled); each is used by one thread until joined.
+  std::unique_ptr<EstimationStage> estimation_;
+  std::unique_ptr<StereoRectifyStage> rectify_;
+  std::unique_ptr<VoStage> vo_stage_;
+  LatencyHistogram rectify_time_;
+  uint64_t rectify_failures_ = 0;
+  int pending_dropped_ = 0;
 
   TelemetryStage* telemetry_ = nullptr;
   mutable std::mutex fault_mutex_;

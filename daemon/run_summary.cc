@@ -73,6 +73,49 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("write_errors", run.recording->write_errors);
     j.EndObject();
   }
+  if (p.estimation_enabled()) {
+    const EstimationReport e = p.estimation_report();
+    const VoStageReport& v = *p.vo_report();
+    j.Key("estimation").BeginObject();
+    j.Field("filter_initialized", e.initialized);
+    j.Field("camera_frames", v.frames);
+    j.Field("rectify_failures", p.rectify_failures());
+    j.Field("trajectory_poses", p.trajectory()->poses.size());
+    j.Field("vo_poses", p.odometry()->poses.size());
+    j.Key("vo").BeginObject();
+    j.Field("keyframes", v.keyframes);
+    uint64_t failures = 0;
+    j.Key("status").BeginObject();
+    for (int i = 0; i < kVoStatusCount; ++i) {
+      const VoStatus st = static_cast<VoStatus>(i);
+      j.Field(VoStatusName(st), v.by_status[static_cast<size_t>(i)]);
+      if (st != VoStatus::kOk && st != VoStatus::kNoKeyframe) failures += v.by_status[static_cast<size_t>(i)];
+    }
+    j.EndObject();
+    j.Field("failures", failures);
+    j.Field("keyframes_dropped_for_missing_clone", v.keyframes_dropped_for_missing_clone);
+    j.EndObject();
+    j.Key("filter").BeginObject();
+    j.Field("imu_accepted", e.filter.imu_accepted);
+    j.Field("clones_requested", e.filter.clones_requested);
+    j.Field("clones_refused", e.clones_failed);
+    j.Field("clones_marginalized", e.filter.clones_marginalized);
+    j.Field("vo_results", e.vo_results);
+    j.Field("vo_updates_applied", e.vo_updates_applied);
+    j.Field("vo_updates_rejected", e.vo_updates_rejected);
+    j.Field("vo_results_without_clone", e.vo_missing_clone);
+    j.Field("updates_applied", e.filter.updates_applied);
+    j.Field("updates_rejected", e.filter.updates_rejected);
+    j.Field("replays", e.filter.replays);
+    j.EndObject();
+    j.Key("frame_switches").BeginObject();
+    j.Field("count", e.frame_switches);
+    j.Field("distance", e.switch_reasons[static_cast<size_t>(FrameSwitchReason::kDistance)]);
+    j.Field("position_sigma", e.switch_reasons[static_cast<size_t>(FrameSwitchReason::kPositionSigma)]);
+    j.EndObject();
+    j.Field("estimates_dropped", e.estimates_dropped);
+    j.EndObject();
+  }
   const FaultReport f = p.fault_report();
   j.Key("faults").BeginObject();
   j.Field("total", f.total);
@@ -125,6 +168,16 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
     j.BeginObject();
     j.Field("stage_input", l.name).Field("count", l.count);
     j.Field("p50_s", l.p50).Field("p99_s", l.p99).Field("max_s", l.max);
+    j.EndObject();
+  }
+  j.EndArray();
+  // Processing time per stage and frame (medians are the figures to compare; timing depends on the
+  // host, so it lives here and not in summary.json).
+  j.Key("stage_timing").BeginArray();
+  for (const StageTimingReport& t : p.stage_timing_reports()) {
+    j.BeginObject();
+    j.Field("stage", t.name).Field("count", t.count);
+    j.Field("median_s", t.p50).Field("p99_s", t.p99).Field("max_s", t.max);
     j.EndObject();
   }
   j.EndArray();

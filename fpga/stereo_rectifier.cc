@@ -49,6 +49,11 @@ Expected<StereoRectifier> StereoRectifier::Create(const StereoCalibration& calib
   cv::initUndistortRectifyMap(CameraMatrix(kr), Distortion(kr), r2, p2, out.size_, CV_16SC2,
                               out.right_map_xy_, out.right_map_frac_);
   out.focal_px_ = p1.at<double>(0, 0);
+  out.cx_ = p1.at<double>(0, 2);
+  out.cy_ = p1.at<double>(1, 2);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out.R_left_rect_(r, c) = r1.at<double>(c, r);
+  }
   out.baseline_ = calibration.baseline();
   return out;
 }

@@ -3,6 +3,7 @@
 // (OpenCV stereoRectify, zero skew, common focal length) and stored in OpenCV's fixed-point
 // format, so each frame costs one integer bilinear remap per image.
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "hal/calibration.h"
@@ -21,6 +22,12 @@ class StereoRectifier {
 
   double focal_px() const { return focal_px_; }
   double baseline() const { return baseline_; }
+  // Principal point of both rectified images (px).
+  double cx() const { return cx_; }
+  double cy() const { return cy_; }
+  // Orientation of the rectified left camera in the original left camera frame (R1^T in
+  // OpenCV's terms): T_body_rect = T_body_cam * [R_left_rect | 0].
+  const Eigen::Matrix3d& R_left_rect() const { return R_left_rect_; }
   cv::Size size() const { return size_; }
 
  private:
@@ -28,6 +35,8 @@ class StereoRectifier {
   cv::Mat left_map_xy_, left_map_frac_, right_map_xy_, right_map_frac_;
   double focal_px_ = 0.0;
   double baseline_ = 0.0;
+  double cx_ = 0.0, cy_ = 0.0;
+  Eigen::Matrix3d R_left_rect_ = Eigen::Matrix3d::Identity();
 };
 
 }  // namespace cairn

@@ -31,5 +31,7 @@ namespace cairn::tools {
 
 int RunMap(const CommandArgs& args);
 int RunBenchMap(const CommandArgs& args);
+int RunEval(const CommandArgs& args);
+int RunBenchVo(const CommandArgs& args);
 
 }  // namespace cairn::tools

@@ -1,0 +1,97 @@
+#pragma once
+// What the hard-real-time estimation thread does with its inputs: the local reference filter on
+// IMU (and wheel) data, a pose clone per stereo frame at its exposure time, the visual-odometry
+// delta poses between the clones of a keyframe and a frame, clone releases, and frame switches
+// on request. Per camera frame it emits the filter's estimate at the frame's time (once the
+// filter has reached it and the frame's odometry result is in), chained through all frame
+// switches into the first frame. All memory is allocated by the constructor.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include <Eigen/Geometry>
+
+#include "daemon/spsc_queue.h"
+#include "estimation/frame_switch_policy.h"
+#include "estimation/keyframe_visual_odometry.h"
+#include "estimation/local_reference_filter.h"
+
+namespace cairn {
+
+// The filter's estimate at one camera frame, and feedback for the odometry.
+struct FrameEstimate {
+  Timestamp time;
+  bool valid = false;          // the filter was initialized and covers the time
+  uint64_t frame_id = 0;       // local frame of T_frame_body
+  Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_first_body = Eigen::Isometry3d::Identity();  // chained through switches
+  double position_sigma = 0.0;  // m, largest standard deviation of the position
+  VoStatus vo_status = VoStatus::kNoKeyframe;
+  // The keyframe the odometry used has no clone in the filter (filter not yet initialized, or the
+  // clone is gone): the odometry must stop using it.
+  bool keyframe_clone_missing = false;
+  Timestamp keyframe_time;
+};
+
+struct FrameSwitchRequest {
+  Timestamp time;  // of the estimate that prompted it
+  FrameSwitchReason reason = FrameSwitchReason::kNone;
+};
+
+struct EstimationReport {
+  FilterCounters filter;
+  uint64_t vo_results = 0;
+  uint64_t vo_updates_applied = 0;
+  uint64_t vo_updates_rejected = 0;  // refused by the filter (gate, covariance, unknown clone)
+  uint64_t vo_missing_clone = 0;     // results whose keyframe or frame has no clone
+  uint64_t clones_failed = 0;        // clone requests the filter refused (e.g. not initialized)
+  uint64_t frame_switches = 0;
+  std::array<uint64_t, 3> switch_reasons{};  // by FrameSwitchReason
+  uint64_t estimates_emitted = 0;
+  uint64_t estimates_dropped = 0;  // output queue full
+  bool initialized = false;
+};
+
+class EstimationStage {
+ public:
+  EstimationStage(const FilterOptions& options, const ImuCalibration& imu, const WheelCalibration& wheels,
+                  SpscQueue<FrameEstimate>* estimates);
+
+  void OnImu(const ImuSample& s);
+  void OnWheel(const WheelOdometrySample& s);
+  void OnFrame(Timestamp time);  // a stereo exposure: clone
+  void OnVoResult(const VoResult& r);
+  void OnFrameSwitch(const FrameSwitchRequest& request);
+
+  bool initialized() const { return filter_.initialized(); }
+  EstimationReport report() const;
+
+ private:
+  struct CloneEntry {
+    Timestamp time;
+    CloneId id = kNoClone;
+  };
+  struct PendingFrame {
+    Timestamp time;
+    VoStatus status = VoStatus::kNoKeyframe;
+    bool missing = false;
+    Timestamp keyframe_time;
+  };
+  CloneId FindClone(Timestamp t) const;
+  void Release(Timestamp t);
+  void Emit(const PendingFrame& f);
+  void FlushPending();
+
+  LocalReferenceFilter filter_;
+  SpscQueue<FrameEstimate>* estimates_;
+  std::array<CloneEntry, 64> clones_{};
+  size_t next_clone_slot_ = 0;
+  std::array<PendingFrame, 32> pending_{};
+  size_t pending_begin_ = 0, pending_end_ = 0;
+  // T_first_frame of the last local frames (indexed by frame id modulo the size).
+  std::array<Eigen::Isometry3d, 64> T_first_frame_{};
+  EstimationReport report_;
+};
+
+}  // namespace cairn
