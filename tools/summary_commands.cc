@@ -5,7 +5,11 @@
 #include <exception>
 #include <string>
 
+#include <filesystem>
+
 #include "daemon/json_value.h"
+#include "estimation/trajectory.h"
+#include "estimation/trajectory_evaluator.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
@@ -13,6 +17,33 @@ namespace {
 
 double CountOf(const JsonValue& streams, const char* name) {
   return streams.has(name) ? streams[name]["count"].number() : 0.0;
+}
+
+// Simulated runs carry their ground truth: score the estimate against it.
+void PrintAccuracy(const std::string& dir) {
+  const std::string est_path = dir + "/trajectory.tum", gt_path = dir + "/ground_truth.tum";
+  if (!std::filesystem::exists(est_path) || !std::filesystem::exists(gt_path)) return;
+  auto est = TrajectoryIo::Read(est_path, TrajectoryFormat::kTum);
+  auto gt = TrajectoryIo::Read(gt_path, TrajectoryFormat::kTum);
+  if (!est.ok() || !gt.ok()) {
+    std::printf("  accuracy: unreadable trajectory (%s)\n",
+                (!est.ok() ? est.status() : gt.status()).message().c_str());
+    return;
+  }
+  auto r = EvaluateTrajectory(*gt, *est, TrajectoryEvalOptions{});
+  if (!r.ok()) {
+    std::printf("  accuracy: %s\n", r.status().message().c_str());
+    return;
+  }
+  std::printf("  accuracy vs ground truth: %.2f m path, ATE RMSE %.3f m, drift %.3f m / %.2f deg yaw",
+              r->path_length, r->ate_rmse, r->drift_translation, r->drift_yaw_deg);
+  for (const SegmentError& e : r->segments) {
+    if (e.pairs > 0) {
+      std::printf(", RPE@%.0fm %.2f %% %.3f deg/m", e.length, e.translation_percent, e.rotation_deg_per_m);
+      break;
+    }
+  }
+  std::printf("\n");
 }
 
 }  // namespace
@@ -35,6 +66,13 @@ int RunSummary(const CommandArgs& args) {
       std::printf("  consumed: imu %.0f, stereo %.0f, wheel odometry %.0f; dropped %.0f; device faults %.0f\n",
                   CountOf(streams, "imu"), CountOf(streams, "stereo"), CountOf(streams, "wheel_odometry"),
                   dropped, s["faults"]["total"].number());
+      if (s.has("estimation")) {
+        const JsonValue& e = s["estimation"];
+        std::printf("  estimation: %.0f camera frames, %.0f poses, VO failures %.0f, frame switches %.0f\n",
+                    e["camera_frames"].number(), e["trajectory_poses"].number(), e["vo"]["failures"].number(),
+                    e["frame_switches"]["count"].number());
+      }
+      PrintAccuracy(dir);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());
       rc = 1;
