@@ -21,6 +21,10 @@ Status SgmOptions::Validate() const {
   if (paths != 4 && paths != 8) {
     return InvalidArgumentError("sgm paths must be 4 or 8, got " + std::to_string(paths));
   }
+  if (raster_paths && paths != 4) {
+    return InvalidArgumentError("sgm raster_paths (FPGA mode) uses 4 paths, got paths " +
+                                std::to_string(paths));
+  }
   if (p2 <= p1) {
     return InvalidArgumentError("sgm p2 (" + std::to_string(p2) + ") must exceed p1 (" +
                                 std::to_string(p1) + ")");
