@@ -72,6 +72,11 @@ uint8_t SgmPathStep(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uin
 // Equiangular sub-pixel offset in 1/kDisparityScale px from the sums at the winner (`at`) and its
 // neighbours, rounded half away from zero; 0 when the denominator is 0.
 int SgmSubpixelOffset(int below, int at, int above);
+// The left-right check of a left winner k against the right image's winner at the match (-1 when
+// that right pixel had no candidate).
+inline bool SgmLeftRightConsistent(int k, int right_k, int max_diff) {
+  return right_k >= 0 && (k > right_k ? k - right_k : right_k - k) <= max_diff;
+}
 // Highway implementation for the best target of this CPU (AVX2, SSE4, NEON, ...).
 const SgmKernels& SimdSgmKernels();
 // Name of the Highway target SimdSgmKernels() dispatches to, for reports.

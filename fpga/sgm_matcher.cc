@@ -51,12 +51,7 @@ SgmMatcher::SgmMatcher(const SgmOptions& options)
       pool_(static_cast<int>(options.threads)),
       rx_(static_cast<int>(options.census_width / 2)),
       ry_(static_cast<int>(options.census_height / 2)) {
-  const int p1 = static_cast<int>(options.p1), p2 = static_cast<int>(options.p2);
-  const int s = static_cast<int>(options.p2_intensity_scale);
-  for (int di = 0; di < 256; ++di) {
-    const int v = s > 0 ? std::max(p1 + 1, p2 * s / (s + di)) : p2;
-    p2_table_[di] = static_cast<uint8_t>(v);
-  }
+  options.FillP2Table(p2_table_);
 }
 
 std::string_view SgmMatcher::name() const {
@@ -224,8 +219,7 @@ void SgmMatcher::FinishRow(Sweep& s, int y) {
     const int xr = x - d;
     if (xr < 0 || xr >= width_) continue;  // matched outside the right image
     if (options_.lr_check) {
-      const int kr = s.right_best[xr];
-      if (kr < 0 || std::abs(kr - k) > max_diff) continue;
+      if (!SgmLeftRightConsistent(k, s.right_best[xr], max_diff)) continue;
     }
     int value = d * kDisparityScale;
     if (options_.subpixel && k > 0 && k < d_count - 1) {

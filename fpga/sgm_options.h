@@ -62,6 +62,8 @@ struct SgmOptions {
 
   Status Validate() const;
   int census_bits() const { return static_cast<int>((census_width * census_height - 1) / 2); }
+  // P2' for every absolute intensity step 0..255 (what the kernels and the FPGA look up).
+  void FillP2Table(uint8_t table[256]) const;
 };
 
 }  // namespace cairn
