@@ -66,7 +66,10 @@ module sgm_top #(
                      src_stride >= {20'd0, width} && dst_stride >= {19'd0, width, 1'b0} &&
                      src_left[2:0] == 0 && src_right[2:0] == 0 && dst[2:0] == 0 &&
                      src_stride[2:0] == 0 && dst_stride[2:0] == 0 && uniqueness <= 99;
-  wire start_ok = start_req && !busy && geometry_ok;
+  // A start waits until reads of an aborted frame have drained (their data is dropped).
+  reg start_pend;
+  reg [3:0] rd_outstanding;
+  wire start_ok = start_pend && rd_outstanding == 0;
   wire fail = busy && (rd_resp_valid && rd_resp_err || wr_err);
   wire frame_done;
   wire in_last;  // the last input pixel enters the census unit
@@ -75,6 +78,7 @@ module sgm_top #(
   always @(posedge clk) begin
     if (rst) begin
       busy <= 0;
+      start_pend <= 0;
       done_flag <= 0;
       cfg_err <= 0;
       rd_err <= 0;
@@ -113,22 +117,27 @@ module sgm_top #(
         endcase
       end
       if (start_req) begin
-        if (busy) overrun <= 1;
+        if (busy || start_pend) overrun <= 1;
         else if (!geometry_ok) begin
           cfg_err <= 1;
           irq_status[1] <= 1;
-        end else begin
-          busy <= 1;
-          done_flag <= 0;
-          cfg_err <= 0;
-          rd_err <= 0;
-          wr_err_flag <= 0;
-          overrun <= 0;
-          cycles <= 0;
-          last_in_seen <= 0;
-        end
+        end else start_pend <= 1;
       end
-      if (abort_req) busy <= 0;
+      if (start_ok) begin
+        start_pend <= 0;
+        busy <= 1;
+        done_flag <= 0;
+        cfg_err <= 0;
+        rd_err <= 0;
+        wr_err_flag <= 0;
+        overrun <= 0;
+        cycles <= 0;
+        last_in_seen <= 0;
+      end
+      if (abort_req) begin
+        busy <= 0;
+        start_pend <= 0;
+      end
       if (busy) cycles <= cycles + 1;
       if (fail) begin
         busy <= 0;
@@ -157,7 +166,8 @@ module sgm_top #(
       12'h00C: reg_rdata <= {HMAX[15:0], WMAX[15:0]};
       12'h010: reg_rdata <= {23'd0, irq_enable, 8'd0};
       12'h014: reg_rdata <= {20'd0, overrun, wr_err_flag, rd_err, cfg_err, 5'd0,
-                             cfg_err | rd_err | wr_err_flag | overrun, done_flag, busy};
+                             cfg_err | rd_err | wr_err_flag | overrun, done_flag,
+                             busy | start_pend};
       12'h018: reg_rdata <= {30'd0, irq_status};
       12'h020: reg_rdata <= {20'd0, width};
       12'h024: reg_rdata <= {20'd0, height};
@@ -196,6 +206,11 @@ module sgm_top #(
   assign rd_req_tag = pick;
   assign rd_req_addr = q_base[pick] + {{(64 - XBITS + 3){1'b0}}, q_word[pick], 3'b0};
   wire req_fire = rd_req_valid && rd_req_ready;
+
+  always @(posedge clk) begin
+    if (rst) rd_outstanding <= 0;
+    else rd_outstanding <= rd_outstanding + {3'd0, req_fire} - {3'd0, rd_resp_valid};
+  end
 
   // Word FIFOs and byte unpackers.
   reg [63:0] wf [0:1][0:3];
@@ -242,14 +257,14 @@ module sgm_top #(
       for (c = 0; c < 2; c = c + 1) begin
         q_credit[c] <= q_credit[c] - {2'd0, req_fire && pick == c} +
                        {2'd0, pix_take && word_end};
-        wf_n[c] <= wf_n[c] + {2'd0, rd_resp_valid && !rd_resp_err && rd_resp_tag == c} -
+        wf_n[c] <= wf_n[c] + {2'd0, busy && rd_resp_valid && !rd_resp_err && rd_resp_tag == c} -
                    {2'd0, pix_take && word_end};
         if (pix_take) begin
           u_col[c] <= u_col[c] == width - 1 ? 0 : u_col[c] + 1;
           if (word_end) wf_rp[c] <= wf_rp[c] + 1;
         end
       end
-      if (rd_resp_valid && !rd_resp_err) begin
+      if (busy && rd_resp_valid && !rd_resp_err) begin
         wf[rd_resp_tag][wf_wp[rd_resp_tag]] <= rd_resp_data;
         wf_wp[rd_resp_tag] <= wf_wp[rd_resp_tag] + 1;
       end
