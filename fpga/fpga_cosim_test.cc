@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -14,42 +13,11 @@
 #include "fpga/sgm_matcher.h"
 #include "fpga/simulated_stereo_device.h"
 #include "fpga/stereo_image_io.h"
+#include "fpga/stereo_test_pair.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
 namespace {
-
-struct Pair {
-  int w = 0, h = 0, stride = 0;
-  std::vector<uint8_t> l, r;
-};
-
-// Random texture; the right image is the left shifted by `shift` px plus noise, so that clear
-// matches, ambiguous ones and occlusions all occur.
-Pair SyntheticPair(int w, int h, int shift, uint32_t seed) {
-  std::mt19937 rng(seed);
-  Pair p{w, h, w, std::vector<uint8_t>(static_cast<size_t>(w) * h),
-         std::vector<uint8_t>(static_cast<size_t>(w) * h)};
-  for (auto& v : p.l) v = static_cast<uint8_t>(rng() & 0xFF);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const int src = std::min(w - 1, x + shift + (y > h / 2 ? 3 : 0));
-      const int v = p.l[static_cast<size_t>(y) * w + src] + static_cast<int>(rng() % 48) - 24;
-      p.r[static_cast<size_t>(y) * w + x] = static_cast<uint8_t>(std::clamp(v, 0, 255));
-    }
-  }
-  return p;
-}
-
-StereoMatcherInput InputOf(const Pair& p) {
-  StereoMatcherInput in;
-  in.left = p.l.data();
-  in.right = p.r.data();
-  in.width = p.w;
-  in.height = p.h;
-  in.stride = p.stride;
-  return in;
-}
 
 SgmOptions FpgaMode(int disparities) {
   SgmOptions o;
@@ -114,7 +82,7 @@ TEST(FpgaCosimTest, RawDisparityOfSyntheticFramesEqualsGolden) {
                         {33, 8, 96, 2, false, true, 25, 10, 100}};
   uint32_t seed = 3;
   for (const Case& c : cases) {
-    const Pair p = SyntheticPair(c.w, c.h, c.shift, seed++);
+    const auto p = TestStereoPair::Make(c.w, c.h, c.shift, seed++, 24, 3);
     SgmOptions o = FpgaMode(c.d);
     o.lr_check = c.lr;
     o.subpixel = c.subpixel;
@@ -123,8 +91,8 @@ TEST(FpgaCosimTest, RawDisparityOfSyntheticFramesEqualsGolden) {
     o.p2 = c.p2;
     o.median = false;  // the device's own output, before the host's post-filters
     o.speckle_max_size = 0;
-    const auto golden = Golden(o, InputOf(p));
-    const auto rtl = Cosim(o, InputOf(p));
+    const auto golden = Golden(o, p.input());
+    const auto rtl = Cosim(o, p.input());
     EXPECT_EQ(golden.disparity, rtl.disparity)
         << c.w << "x" << c.h << " d " << c.d << ": " << FirstDifference(golden, rtl);
     EXPECT_GT(CountValid(golden.disparity), c.w * c.h / 10);
@@ -132,14 +100,15 @@ TEST(FpgaCosimTest, RawDisparityOfSyntheticFramesEqualsGolden) {
 }
 
 TEST(FpgaCosimTest, FilteredOutputEqualsGoldenAndReusesTheDevice) {
-  const Pair a = SyntheticPair(48, 16, 6, 21), b = SyntheticPair(48, 16, 11, 22);
+  const auto a = TestStereoPair::Make(48, 16, 6, 21, 24, 3);
+  const auto b = TestStereoPair::Make(48, 16, 11, 22, 24, 3);
   const SgmOptions o = FpgaMode(32);  // median and speckle filter on, as configured by default
   auto m = FpgaStereoMatcher::Create(o, std::make_unique<SimulatedStereoDevice>());
   ASSERT_TRUE(m.ok()) << m.status().ToString();
   StereoMatcherOutput out;
-  for (const Pair* p : {&a, &b, &a}) {
-    ASSERT_TRUE((*m)->Match(InputOf(*p), &out).ok());
-    const auto golden = Golden(o, InputOf(*p));
+  for (const TestStereoPair* p : {&a, &b, &a}) {
+    ASSERT_TRUE((*m)->Match(p->input(), &out).ok());
+    const auto golden = Golden(o, p->input());
     EXPECT_EQ(golden.disparity, out.disparity) << FirstDifference(golden, out);
   }
 }

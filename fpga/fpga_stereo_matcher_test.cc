@@ -3,7 +3,6 @@
 // each recoverable error the device must run the next frame correctly.
 
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -13,31 +12,14 @@
 #include "fpga/sgm_matcher.h"
 #include "fpga/sgm_registers.h"
 #include "fpga/simulated_stereo_device.h"
+#include "fpga/stereo_test_pair.h"
 #include "fpga/uio_stereo_device.h"
 
 namespace cairn {
 namespace {
 
-struct Frame {
-  int w = 40, h = 12;
-  std::vector<uint8_t> l, r;
-  Frame() : l(static_cast<size_t>(w) * h), r(static_cast<size_t>(w) * h) {
-    std::mt19937 rng(9);
-    for (auto& v : l) v = static_cast<uint8_t>(rng());
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) r[y * w + x] = l[y * w + std::min(w - 1, x + 4)];
-    }
-  }
-  StereoMatcherInput input() const {
-    StereoMatcherInput in;
-    in.left = l.data();
-    in.right = r.data();
-    in.width = w;
-    in.height = h;
-    in.stride = w;
-    return in;
-  }
-};
+// The pair every test here matches.
+TestStereoPair Frame() { return TestStereoPair::Make(40, 12, 4, 9); }
 
 SgmOptions FpgaMode() {
   SgmOptions o;
@@ -46,7 +28,7 @@ SgmOptions FpgaMode() {
   return o;
 }
 
-std::vector<int16_t> Golden(const Frame& f) {
+std::vector<int16_t> Golden(const TestStereoPair& f) {
   auto m = SgmMatcher::Create(FpgaMode());
   StereoMatcherOutput out;
   EXPECT_TRUE(m.ok() && (*m)->Match(f.input(), &out).ok());
@@ -125,7 +107,7 @@ TEST(FpgaStereoMatcherTest, RejectsOptionsTheCoreCannotRun) {
 }
 
 TEST(FpgaStereoMatcherTest, DmaReadFaultIsReportedAndTheNextFrameWorks) {
-  const Frame f;
+  const TestStereoPair f = Frame();
   SimulatedStereoDevice* dev = nullptr;
   auto m = OnSimulator(&dev, std::chrono::milliseconds(50));
   ASSERT_NE(m, nullptr);
@@ -139,7 +121,7 @@ TEST(FpgaStereoMatcherTest, DmaReadFaultIsReportedAndTheNextFrameWorks) {
 }
 
 TEST(FpgaStereoMatcherTest, HungBusTimesOutAndAbortRecovers) {
-  const Frame f;
+  const TestStereoPair f = Frame();
   SimulatedStereoDevice* dev = nullptr;
   auto m = OnSimulator(&dev, std::chrono::microseconds(200));  // 30000 simulated cycles
   ASSERT_NE(m, nullptr);
@@ -154,7 +136,7 @@ TEST(FpgaStereoMatcherTest, HungBusTimesOutAndAbortRecovers) {
 }
 
 TEST(FpgaStereoMatcherTest, RemovalMidFrameIsReported) {
-  const Frame f;
+  const TestStereoPair f = Frame();
   SimulatedStereoDevice* dev = nullptr;
   auto m = OnSimulator(&dev, std::chrono::milliseconds(50));
   ASSERT_NE(m, nullptr);

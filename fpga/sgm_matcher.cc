@@ -156,6 +156,13 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
     kernels_->horizontal(s.cost.get(), image_row(y), g, p2_table_, p1,
                          s.horizontal_scratch.get() + kPathLead, s.row_sum.get());
   }
+  VerticalPaths(s, y, paths, finish ? sum_row : s.row_sum.get(),
+                finish ? s.row_sum.get() : sum_row, /*stream_dst=*/!finish);
+  if (finish) FinishRow(s, y);
+}
+
+void SgmMatcher::VerticalPaths(Sweep& s, int y, int paths, const uint16_t* src, uint16_t* dst,
+                               bool stream_dst) {
   const int prev = 1 - s.cur;
   uint8_t* prev_paths[3];
   const uint8_t* prev_min[3];
@@ -167,14 +174,13 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
     cur_paths[p] = s.path[s.cur][p].get() + kPathLead;
     cur_min[p] = s.path_min[s.cur][p].get();
   }
-  kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr, g,
-                     paths, p2_table_, p1, s.has_prev ? prev_paths : nullptr, prev_min,
-                     cur_paths, cur_min, finish ? sum_row : s.row_sum.get(),
-                     finish ? s.row_sum.get() : sum_row, /*stream_dst=*/!finish);
+  kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr,
+                     geometry_, paths, p2_table_, static_cast<uint8_t>(options_.p1),
+                     s.has_prev ? prev_paths : nullptr, prev_min, cur_paths, cur_min, src, dst,
+                     stream_dst);
   s.cur = prev;
   s.has_prev = true;
   s.prev_y = y;
-  if (finish) FinishRow(s, y);
 }
 
 void SgmMatcher::RasterRow(Sweep& s, int y) {
@@ -183,24 +189,8 @@ void SgmMatcher::RasterRow(Sweep& s, int y) {
   ComputeCost(s, y);
   kernels_->horizontal_forward(s.cost.get(), image_row(y), g, p2_table_, p1,
                                s.horizontal_scratch.get() + kPathLead, s.row_sum.get());
-  const int prev = 1 - s.cur;
-  uint8_t* prev_paths[3];
-  const uint8_t* prev_min[3];
-  uint8_t* cur_paths[3];
-  uint8_t* cur_min[3];
-  for (int p = 0; p < 3; ++p) {
-    prev_paths[p] = s.path[prev][p].get() + kPathLead;
-    prev_min[p] = s.path_min[prev][p].get();
-    cur_paths[p] = s.path[s.cur][p].get() + kPathLead;
-    cur_min[p] = s.path_min[s.cur][p].get();
-  }
   // Up, up-left and up-right (the three paths arriving from the row above), added in place.
-  kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr, g,
-                     3, p2_table_, p1, s.has_prev ? prev_paths : nullptr, prev_min, cur_paths,
-                     cur_min, s.row_sum.get(), s.row_sum.get(), /*stream_dst=*/false);
-  s.cur = prev;
-  s.has_prev = true;
-  s.prev_y = y;
+  VerticalPaths(s, y, 3, s.row_sum.get(), s.row_sum.get(), /*stream_dst=*/false);
   FinishRow(s, y);
 }
 

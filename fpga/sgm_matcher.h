@@ -66,6 +66,9 @@ class SgmMatcher final : public StereoMatcher {
   // Aggregates row y in a sweep; with `finish` the row is complete afterwards and gets its
   // disparities.
   void SweepRow(Sweep& s, int y, bool finish);
+  // The paths arriving from the previous row of the sweep: dst = src + their costs.
+  void VerticalPaths(Sweep& s, int y, int paths, const uint16_t* src, uint16_t* dst,
+                     bool stream_dst);
   // raster_paths mode: the forward horizontal and the three upper paths of row y, then its
   // disparities.
   void RasterRow(Sweep& s, int y);

@@ -2,38 +2,20 @@
 // that fails in the middle of a run (one warning, a counter, CPU output from then on).
 
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "fpga/simulated_stereo_device.h"
+#include "fpga/stereo_test_pair.h"
 #include "fpga/stereo_backend_switch.h"
 
 namespace cairn {
 namespace {
 
-struct Frame {
-  int w = 36, h = 10;
-  std::vector<uint8_t> l, r;
-  Frame() : l(static_cast<size_t>(w) * h), r(static_cast<size_t>(w) * h) {
-    std::mt19937 rng(17);
-    for (auto& v : l) v = static_cast<uint8_t>(rng());
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) r[y * w + x] = l[y * w + std::min(w - 1, x + 6)];
-    }
-  }
-  StereoMatcherInput input() const {
-    StereoMatcherInput in;
-    in.left = l.data();
-    in.right = r.data();
-    in.width = w;
-    in.height = h;
-    in.stride = w;
-    return in;
-  }
-};
+// The pair every test here matches.
+TestStereoPair Frame() { return TestStereoPair::Make(36, 10, 6, 17); }
 
 SgmOptions FpgaMode() {
   SgmOptions o;
@@ -63,7 +45,7 @@ StereoBackendSwitch::DeviceOpener Simulated(SimulatedStereoDevice** handle = nul
   };
 }
 
-std::vector<int16_t> Cpu(const Frame& f) {
+std::vector<int16_t> Cpu(const TestStereoPair& f) {
   auto m = SgmMatcher::Create(FpgaMode());
   StereoMatcherOutput out;
   EXPECT_TRUE(m.ok() && (*m)->Match(f.input(), &out).ok());
@@ -79,7 +61,7 @@ TEST(StereoBackendSwitchTest, CpuNeverOpensTheDevice) {
   ASSERT_TRUE(s.ok());
   EXPECT_FALSE(opened);
   EXPECT_FALSE((*s)->fpga_active());
-  const Frame f;
+  const TestStereoPair f = Frame();
   StereoMatcherOutput out;
   ASSERT_TRUE((*s)->Match(f.input(), &out).ok());
   EXPECT_EQ((*s)->cpu_frames(), 1u);
@@ -87,7 +69,7 @@ TEST(StereoBackendSwitchTest, CpuNeverOpensTheDevice) {
 }
 
 TEST(StereoBackendSwitchTest, FpgaAndAutoUseThePresentDeviceWithTheCpuResult) {
-  const Frame f;
+  const TestStereoPair f = Frame();
   for (StereoBackend b : {StereoBackend::kFpga, StereoBackend::kAuto}) {
     auto s = StereoBackendSwitch::Create(Backend(b), FpgaMode(), Simulated());
     ASSERT_TRUE(s.ok()) << s.status().ToString();
@@ -101,7 +83,7 @@ TEST(StereoBackendSwitchTest, FpgaAndAutoUseThePresentDeviceWithTheCpuResult) {
 }
 
 TEST(StereoBackendSwitchTest, AbsentDeviceFallsBackWithOneWarningOnlyWhenAskedFor) {
-  const Frame f;
+  const TestStereoPair f = Frame();
   std::vector<std::string> warnings;
   const auto warn = [&warnings](const std::string& m) { warnings.push_back(m); };
   auto fpga = StereoBackendSwitch::Create(Backend(StereoBackend::kFpga), FpgaMode(), Absent(), warn);
@@ -135,7 +117,7 @@ TEST(StereoBackendSwitchTest, OptionsTheCoreCannotRun) {
 }
 
 TEST(StereoBackendSwitchTest, FailureMidRunSwitchesToTheCpuOnceAndKeepsRunning) {
-  const Frame f;
+  const TestStereoPair f = Frame();
   const auto golden = Cpu(f);
   std::vector<std::string> warnings;
   SimulatedStereoDevice* dev = nullptr;
