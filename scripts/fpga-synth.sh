@@ -14,12 +14,16 @@ srcs="$rtl/sgm_top.v $rtl/sgm_core.v $rtl/sgm_census_unit.v $rtl/sgm_census5x5.v
 $rtl/sgm_cost_lanes.v $rtl/sgm_path_step.v $rtl/sgm_argmin.v $rtl/sgm_subpixel.v $rtl/sgm_lr_check.v"
 params="-set LANES $lanes -set DMAX $dmax -set WMAX $wmax"
 
+# Yosys' SAT-based passes (`share`, memory port sharing) run for hours on this design's wide muxes
+# and gain little: both flows replace the stock coarse step by the same steps without them.
+coarse="proc; flatten; opt_expr; opt_clean; check; opt -nodffe -nosdff; fsm; opt; wreduce; \
+  peepopt; opt_clean; alumacc; opt; memory -nomap -nosat; opt_clean"
+
 echo "== generic synth (LANES=$lanes DMAX=$dmax WMAX=$wmax)"
-# `synth` up to its fine stage, then the same steps without memory_map: the generic library has no
-# RAM, and turning the row buffers into flip-flops would only measure Yosys' patience. Memories stay
-# $mem cells (counted below); everything else is mapped to gates.
+# Gates from the generic library; the generic library has no RAM, and turning the row buffers into
+# flip-flops would only measure Yosys' patience, so memories stay \$mem cells (counted below).
 yosys -q -l "$out/generic.log" -p "read_verilog $srcs; chparam $params sgm_top; \
-  synth -top sgm_top -flatten -run :fine; opt -fast -full; techmap; opt -fast; abc -fast; \
+  hierarchy -check -top sgm_top; $coarse; opt -fast -full; techmap; opt -fast; abc -fast; \
   opt -fast; check -assert; tee -o $out/generic_stat.txt stat" >/dev/null
 if grep -qi "latch" "$out/generic_stat.txt" || grep -q "\$dlatch\|\$_DLATCH" "$out/generic_stat.txt"; then
   echo "latches found:"; grep -i latch "$out/generic_stat.txt"; exit 1
@@ -28,7 +32,12 @@ grep -E "Number of cells|Number of wire bits|mem" "$out/generic_stat.txt" | head
 
 echo "== synth_xilinx -family xc7"
 yosys -q -l "$out/xilinx.log" -p "read_verilog $srcs; chparam $params sgm_top; \
-  synth_xilinx -top sgm_top -family xc7 -flatten; tee -o $out/xilinx_stat.txt stat" >/dev/null
+  synth_xilinx -top sgm_top -family xc7 -flatten -run :map_dsp; \
+  synth_xilinx -top sgm_top -family xc7 -flatten -run map_dsp:coarse; \
+  techmap -map +/cmp2lut.v -map +/cmp2lcu.v -D LUT_WIDTH=6; alumacc; opt; \
+  memory -nomap -nosat; opt_clean; \
+  synth_xilinx -top sgm_top -family xc7 -flatten -run map_memory:; \
+  tee -o $out/xilinx_stat.txt stat" >/dev/null
 if grep -q "LDCE\|LDPE" "$out/xilinx_stat.txt"; then echo "latches found"; exit 1; fi
 count() { awk -v pat="$1" '$1 ~ pat {s += $2} END {print s + 0}' "$out/xilinx_stat.txt"; }
 luts=$(count '^LUT[1-6]$')
