@@ -43,6 +43,10 @@ struct SgmKernels {
   // The left-to-right and right-to-left paths; sum = their sum. scratch: a path row of 4 blocks.
   void (*horizontal)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum);
+  // Only the left-to-right path (raster_paths mode); sum = its costs.
+  void (*horizontal_forward)(const uint8_t* cost, const uint8_t* image_row,
+                             const SgmRowGeometry& g, const uint8_t* p2_table, uint8_t p1,
+                             uint8_t* scratch, uint16_t* sum);
   // `paths` (1 or 3) paths arriving from the previous row at x, x-1, x+1. prev == nullptr on the
   // first row of a sweep. dst[x*D + k] = src[...] + sum of the new path costs (dst may be src).
   // stream_dst hints that dst is not read again soon (a backend may bypass the cache).
@@ -58,6 +62,21 @@ struct SgmKernels {
 };
 
 const SgmKernels& ScalarSgmKernels();
+
+// Golden-model pieces that the RTL unit benches check the hardware against.
+// One recursion step over d_count disparities: out[k] = c[k] + min(prev[k], prev[k-1] + p1,
+// prev[k+1] + p1, min_prev + p2) - min_prev (sums saturate at 255, which only the sentinels
+// reach; prev[-1] and prev[d_count] must be readable). Returns min_k out[k].
+uint8_t SgmPathStep(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uint8_t p1,
+                    uint8_t p2, int d_count, uint8_t* out);
+// Equiangular sub-pixel offset in 1/kDisparityScale px from the sums at the winner (`at`) and its
+// neighbours, rounded half away from zero; 0 when the denominator is 0.
+int SgmSubpixelOffset(int below, int at, int above);
+// The left-right check of a left winner k against the right image's winner at the match (-1 when
+// that right pixel had no candidate).
+inline bool SgmLeftRightConsistent(int k, int right_k, int max_diff) {
+  return right_k >= 0 && (k > right_k ? k - right_k : right_k - k) <= max_diff;
+}
 // Highway implementation for the best target of this CPU (AVX2, SSE4, NEON, ...).
 const SgmKernels& SimdSgmKernels();
 // Name of the Highway target SimdSgmKernels() dispatches to, for reports.

@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "mapping/stereo_error_model.h"
+#include "fpga/stereo_depth.h"
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -51,15 +51,13 @@ SgmMatcher::SgmMatcher(const SgmOptions& options)
       pool_(static_cast<int>(options.threads)),
       rx_(static_cast<int>(options.census_width / 2)),
       ry_(static_cast<int>(options.census_height / 2)) {
-  const int p1 = static_cast<int>(options.p1), p2 = static_cast<int>(options.p2);
-  const int s = static_cast<int>(options.p2_intensity_scale);
-  for (int di = 0; di < 256; ++di) {
-    const int v = s > 0 ? std::max(p1 + 1, p2 * s / (s + di)) : p2;
-    p2_table_[di] = static_cast<uint8_t>(v);
-  }
+  options.FillP2Table(p2_table_);
 }
 
 std::string_view SgmMatcher::name() const {
+  if (options_.raster_paths) {
+    return options_.backend == SgmBackend::kScalar ? "sgm-scalar-raster" : "sgm-simd-raster";
+  }
   return options_.backend == SgmBackend::kScalar ? "sgm-scalar" : "sgm-simd";
 }
 
@@ -84,8 +82,10 @@ void SgmMatcher::Allocate(int width, int height) {
   std::memset(pad_right_.get(), 0, pad_bytes);
   census_left_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
   census_right_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
-  sum_ = AllocateBuffer<uint16_t>(w * h * d, &buffer_bytes_);
-  AdviseHugePages(sum_.get(), w * h * d * sizeof(uint16_t));
+  if (!options_.raster_paths) {  // the raster pass needs no sum volume
+    sum_ = AllocateBuffer<uint16_t>(w * h * d, &buffer_bytes_);
+    AdviseHugePages(sum_.get(), w * h * d * sizeof(uint16_t));
+  }
   raw_ = AllocateBuffer<int16_t>(w * h, &buffer_bytes_);
   filtered_ = AllocateBuffer<int16_t>(w * h, &buffer_bytes_);
   const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
@@ -156,6 +156,13 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
     kernels_->horizontal(s.cost.get(), image_row(y), g, p2_table_, p1,
                          s.horizontal_scratch.get() + kPathLead, s.row_sum.get());
   }
+  VerticalPaths(s, y, paths, finish ? sum_row : s.row_sum.get(),
+                finish ? s.row_sum.get() : sum_row, /*stream_dst=*/!finish);
+  if (finish) FinishRow(s, y);
+}
+
+void SgmMatcher::VerticalPaths(Sweep& s, int y, int paths, const uint16_t* src, uint16_t* dst,
+                               bool stream_dst) {
   const int prev = 1 - s.cur;
   uint8_t* prev_paths[3];
   const uint8_t* prev_min[3];
@@ -167,14 +174,24 @@ void SgmMatcher::SweepRow(Sweep& s, int y, bool finish) {
     cur_paths[p] = s.path[s.cur][p].get() + kPathLead;
     cur_min[p] = s.path_min[s.cur][p].get();
   }
-  kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr, g,
-                     paths, p2_table_, p1, s.has_prev ? prev_paths : nullptr, prev_min,
-                     cur_paths, cur_min, finish ? sum_row : s.row_sum.get(),
-                     finish ? s.row_sum.get() : sum_row, /*stream_dst=*/!finish);
+  kernels_->vertical(s.cost.get(), image_row(y), s.has_prev ? image_row(s.prev_y) : nullptr,
+                     geometry_, paths, p2_table_, static_cast<uint8_t>(options_.p1),
+                     s.has_prev ? prev_paths : nullptr, prev_min, cur_paths, cur_min, src, dst,
+                     stream_dst);
   s.cur = prev;
   s.has_prev = true;
   s.prev_y = y;
-  if (finish) FinishRow(s, y);
+}
+
+void SgmMatcher::RasterRow(Sweep& s, int y) {
+  const SgmRowGeometry& g = geometry_;
+  const uint8_t p1 = static_cast<uint8_t>(options_.p1);
+  ComputeCost(s, y);
+  kernels_->horizontal_forward(s.cost.get(), image_row(y), g, p2_table_, p1,
+                               s.horizontal_scratch.get() + kPathLead, s.row_sum.get());
+  // Up, up-left and up-right (the three paths arriving from the row above), added in place.
+  VerticalPaths(s, y, 3, s.row_sum.get(), s.row_sum.get(), /*stream_dst=*/false);
+  FinishRow(s, y);
 }
 
 void SgmMatcher::FinishRow(Sweep& s, int y) {
@@ -192,46 +209,14 @@ void SgmMatcher::FinishRow(Sweep& s, int y) {
     const int xr = x - d;
     if (xr < 0 || xr >= width_) continue;  // matched outside the right image
     if (options_.lr_check) {
-      const int kr = s.right_best[xr];
-      if (kr < 0 || std::abs(kr - k) > max_diff) continue;
+      if (!SgmLeftRightConsistent(k, s.right_best[xr], max_diff)) continue;
     }
     int value = d * kDisparityScale;
     if (options_.subpixel && k > 0 && k < d_count - 1) {
-      // Equiangular (V-shaped) fit through the winner and its neighbours, in 1/16 px with
-      // round-half-away-from-zero so that the result is symmetric.
       const uint16_t* sr = s.row_sum.get() + static_cast<size_t>(x) * d_count;
-      const int a = sr[k - 1], c = sr[k + 1], m = sr[k];
-      const int den = std::max(a, c) - m;
-      if (den > 0) {
-        const int num = (a - c) * (kDisparityScale / 2);
-        value += num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
-      }
+      value += SgmSubpixelOffset(sr[k - 1], sr[k], sr[k + 1]);
     }
     out[x] = static_cast<int16_t>(value);
-  }
-}
-
-void SgmMatcher::ComputeDepth(const StereoMatcherInput& input, StereoMatcherOutput* out, int y0,
-                              int y1) const {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const bool geometry = input.focal_px > 0.0 && input.baseline_m > 0.0;
-  const StereoErrorModel model(geometry ? input.focal_px : 1.0, geometry ? input.baseline_m : 1.0,
-                               options_.pixel_error_px);
-  const double fb = input.focal_px * input.baseline_m;
-  for (int y = y0; y < y1; ++y) {
-    for (int x = 0; x < width_; ++x) {
-      const size_t i = static_cast<size_t>(y) * width_ + x;
-      const int16_t d = out->disparity[i];
-      const double disp = static_cast<double>(d) / kDisparityScale + input.disparity_offset_px;
-      if (!geometry || d == kInvalidDisparity || disp <= 0.0) {
-        out->depth[i] = nan;
-        out->depth_sigma[i] = nan;
-        continue;
-      }
-      const double z = fb / disp;
-      out->depth[i] = static_cast<float>(z);
-      out->depth_sigma[i] = static_cast<float>(model.DepthError(z));
-    }
   }
 }
 
@@ -252,13 +237,7 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
   if (input.width != width_ || input.height != height_) Allocate(input.width, input.height);
   const int w = width_, h = height_;
   const size_t n = static_cast<size_t>(w) * h;
-  if (output->width != w || output->height != h || output->disparity.size() != n) {
-    output->width = w;
-    output->height = h;
-    output->disparity.resize(n);
-    output->depth.resize(n);
-    output->depth_sigma.resize(n);
-  }
+  ResizeStereoOutput(w, h, output);
   using Clock = std::chrono::steady_clock;
   auto mark = Clock::now();
   const auto lap = [&mark](double* ms) {
@@ -293,26 +272,33 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
   });
 
   lap(&times_.census_ms);
-  // The two sweeps (see the header): sweep 0 top-down, sweep 1 bottom-up.
-  const int half = h / 2;
   for (Sweep& s : sweeps_) s.has_prev = false;
-  pool_.ForEach(2, [&](int t) {
-    if (t == 0) {
-      for (int y = 0; y < half; ++y) SweepRow(sweeps_[0], y, false);
-    } else {
-      for (int y = h - 1; y >= half; --y) SweepRow(sweeps_[1], y, false);
-    }
-  });
-  lap(&times_.first_half_ms);
-  pool_.ForEach(2, [&](int t) {
-    if (t == 0) {
-      for (int y = half; y < h; ++y) SweepRow(sweeps_[0], y, true);
-    } else {
-      for (int y = half - 1; y >= 0; --y) SweepRow(sweeps_[1], y, true);
-    }
-  });
+  if (options_.raster_paths) {
+    // FPGA mode: one top-down pass finishes every row as soon as it is reached (no sum volume).
+    for (int y = 0; y < h; ++y) RasterRow(sweeps_[0], y);
+    lap(&times_.first_half_ms);
+    times_.second_half_ms = 0.0;
+  } else {
+    // The two sweeps (see the header): sweep 0 top-down, sweep 1 bottom-up.
+    const int half = h / 2;
+    pool_.ForEach(2, [&](int t) {
+      if (t == 0) {
+        for (int y = 0; y < half; ++y) SweepRow(sweeps_[0], y, false);
+      } else {
+        for (int y = h - 1; y >= half; --y) SweepRow(sweeps_[1], y, false);
+      }
+    });
+    lap(&times_.first_half_ms);
+    pool_.ForEach(2, [&](int t) {
+      if (t == 0) {
+        for (int y = half; y < h; ++y) SweepRow(sweeps_[0], y, true);
+      } else {
+        for (int y = half - 1; y >= 0; --y) SweepRow(sweeps_[1], y, true);
+      }
+    });
+    lap(&times_.second_half_ms);
+  }
 
-  lap(&times_.second_half_ms);
   // Post-filters, shared by every backend.
   int16_t* disp = raw_.get();
   if (options_.median) {
@@ -334,7 +320,7 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
   pool_.ForEach(tasks, [&](int t) {
     int y0, y1;
     band(t, h, &y0, &y1);
-    ComputeDepth(input, output, y0, y1);
+    ComputeStereoDepth(input, options_.pixel_error_px, output, y0, y1);
   });
   lap(&times_.depth_ms);
   return Status::Ok();

@@ -8,7 +8,8 @@
 // adding the two horizontal paths there), then continues into the other half, where S already
 // holds every other path, and finishes each row with winner-take-all. The two sweeps run on two
 // threads without ever touching the same row at the same time; the sums are integers, so the
-// result does not depend on the thread count.
+// result does not depend on the thread count. With raster_paths (the FPGA mode) a single top-down
+// pass aggregates left-to-right, up-left, up and up-right and finishes each row at once.
 
 #include <cstdint>
 #include <memory>
@@ -65,8 +66,13 @@ class SgmMatcher final : public StereoMatcher {
   // Aggregates row y in a sweep; with `finish` the row is complete afterwards and gets its
   // disparities.
   void SweepRow(Sweep& s, int y, bool finish);
+  // The paths arriving from the previous row of the sweep: dst = src + their costs.
+  void VerticalPaths(Sweep& s, int y, int paths, const uint16_t* src, uint16_t* dst,
+                     bool stream_dst);
+  // raster_paths mode: the forward horizontal and the three upper paths of row y, then its
+  // disparities.
+  void RasterRow(Sweep& s, int y);
   void FinishRow(Sweep& s, int y);
-  void ComputeDepth(const StereoMatcherInput& input, StereoMatcherOutput* out, int y0, int y1) const;
   const uint8_t* image_row(int y) const { return pad_left_.get() + (y + ry_) * pad_stride_ + rx_; }
 
   SgmOptions options_;

@@ -97,10 +97,13 @@ std::string DataDir() {
 TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
   struct Case {
     int w, h, min_d, num_d, paths, cw, ch, threads;
+    bool raster = false;
   };
-  const Case cases[] = {{97, 41, 0, 32, 4, 9, 7, 2},  {97, 41, 0, 32, 8, 9, 7, 1},
-                        {64, 30, -8, 48, 4, 5, 5, 2}, {130, 23, 3, 64, 8, 7, 5, 3},
-                        {33, 17, 0, 128, 4, 9, 7, 2}, {80, 40, 0, 16, 8, 3, 3, 2}};
+  const Case cases[] = {{97, 41, 0, 32, 4, 9, 7, 2},        {97, 41, 0, 32, 8, 9, 7, 1},
+                        {64, 30, -8, 48, 4, 5, 5, 2},       {130, 23, 3, 64, 8, 7, 5, 3},
+                        {33, 17, 0, 128, 4, 9, 7, 2},       {80, 40, 0, 16, 8, 3, 3, 2},
+                        {97, 41, 0, 32, 4, 5, 5, 2, true},  {64, 30, -8, 48, 4, 9, 7, 1, true},
+                        {33, 17, 0, 128, 4, 5, 5, 2, true}};
   uint32_t seed = 1;
   for (const Case& c : cases) {
     // Random left image; the right one is the left shifted by 5 px plus strong noise, so that
@@ -120,6 +123,7 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
     o.min_disparity = c.min_d;
     o.num_disparities = c.num_d;
     o.paths = c.paths;
+    o.raster_paths = c.raster;
     o.census_width = c.cw;
     o.census_height = c.ch;
     o.threads = c.threads;
@@ -129,7 +133,7 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
     const auto b = RunSgm(o, l, r, c.w, c.h);
     ASSERT_EQ(a.disparity.size(), static_cast<size_t>(c.w) * c.h);
     EXPECT_EQ(a.disparity, b.disparity) << c.w << "x" << c.h << " d " << c.min_d << "+" << c.num_d
-                                        << " paths " << c.paths;
+                                        << " paths " << c.paths << " raster " << c.raster;
     const long valid = std::count_if(a.disparity.begin(), a.disparity.end(),
                                       [](int16_t d) { return d != kInvalidDisparity; });
     EXPECT_GT(valid, 0);
@@ -144,10 +148,11 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRealImages) {
   // A crop with an odd width and a stride larger than the width.
   const cv::Rect roi(100, 120, 181, 90);
   const cv::Mat l = pair->left(roi), r = pair->right(roi);
-  for (int paths : {4, 8}) {
+  for (int paths : {4, 8, 0}) {  // 0: raster_paths (the FPGA mode)
     SgmOptions o;
     o.num_disparities = 64;
-    o.paths = paths;
+    o.paths = paths == 0 ? 4 : paths;
+    o.raster_paths = paths == 0;
     o.backend = SgmBackend::kScalar;
     const auto a = RunSgm(o, l.data, r.data, l.cols, l.rows, static_cast<int>(l.step[0]));
     o.backend = SgmBackend::kSimd;
@@ -205,6 +210,31 @@ TEST(SgmMatcherTest, RecoversConstantDisparity) {
     }
   }
   EXPECT_GT(good, 0.98 * checked);
+}
+
+TEST(SgmMatcherTest, RasterPathsRecoverConstantDisparityWithoutTheSumVolume) {
+  const int w = 160, h = 60;
+  std::vector<uint8_t> l, r;
+  MakePair(w, h, [](double, double) { return 9.0; }, &l, &r);
+  SgmOptions o;
+  o.num_disparities = 32;
+  o.raster_paths = true;
+  auto m = SgmMatcher::Create(o);
+  ASSERT_TRUE(m.ok());
+  StereoMatcherOutput out;
+  ASSERT_TRUE((*m)->Match(InputOf(l.data(), r.data(), w, h, w), &out).ok());
+  EXPECT_LT((*m)->buffer_bytes(), static_cast<size_t>(w) * h * 32);  // no W x H x D volume
+  int checked = 0, good = 0;
+  for (int y = 4; y < h - 4; ++y) {
+    for (int x = 20; x < w - 5; ++x) {
+      ++checked;
+      const int16_t d = out.disparity_at(x, y);
+      good += d != kInvalidDisparity && std::abs(d / 16.0 - 9.0) <= 0.25;
+    }
+  }
+  EXPECT_GT(good, 0.97 * checked);
+  o.paths = 8;
+  EXPECT_FALSE(o.Validate().ok());
 }
 
 TEST(SgmMatcherTest, RecoversSlantedDisparityToAQuarterPixel) {

@@ -1,5 +1,6 @@
 #include "fpga/sgm_options.h"
 
+#include <algorithm>
 #include <string>
 
 namespace cairn {
@@ -21,6 +22,10 @@ Status SgmOptions::Validate() const {
   if (paths != 4 && paths != 8) {
     return InvalidArgumentError("sgm paths must be 4 or 8, got " + std::to_string(paths));
   }
+  if (raster_paths && paths != 4) {
+    return InvalidArgumentError("sgm raster_paths (FPGA mode) uses 4 paths, got paths " +
+                                std::to_string(paths));
+  }
   if (p2 <= p1) {
     return InvalidArgumentError("sgm p2 (" + std::to_string(p2) + ") must exceed p1 (" +
                                 std::to_string(p1) + ")");
@@ -32,6 +37,14 @@ Status SgmOptions::Validate() const {
                                 std::to_string((255 - census_bits()) / 2));
   }
   return Status::Ok();
+}
+
+void SgmOptions::FillP2Table(uint8_t table[256]) const {
+  const int a = static_cast<int>(p1), b = static_cast<int>(p2);
+  const int s = static_cast<int>(p2_intensity_scale);
+  for (int di = 0; di < 256; ++di) {
+    table[di] = static_cast<uint8_t>(s > 0 ? std::max(a + 1, b * s / (s + di)) : b);
+  }
 }
 
 }  // namespace cairn

@@ -17,6 +17,9 @@ struct SgmOptions {
   int64_t census_width = 5;
   int64_t census_height = 5;
   int64_t paths = 4;               // 4 (horizontal + vertical) or 8 (plus diagonals)
+  // FPGA mode: the 4 paths that a streaming core can compute in raster order (left-to-right,
+  // up-left, up, up-right) in one top-down pass, instead of `paths`' set; needs paths: 4.
+  bool raster_paths = false;
   int64_t p1 = 6;                  // penalty for a disparity change of 1 px
   int64_t p2 = 40;                 // penalty for larger changes; census bits + 2 p2 <= 255
   // P2 falls to p2 * s / (s + |dI|) across an intensity step dI (but not below p1 + 1): depth
@@ -40,6 +43,7 @@ struct SgmOptions {
     v.Integer("census_width", census_width, 3, 13, "px");
     v.Integer("census_height", census_height, 3, 13, "px");
     v.Integer("paths", paths, 4, 8, "");
+    v.Flag("raster_paths", raster_paths);
     v.Integer("p1", p1, 1, 255, "cost");
     v.Integer("p2", p2, 2, 127, "cost");
     v.Integer("p2_intensity_scale", p2_intensity_scale, 0, 255, "gray levels");
@@ -58,6 +62,8 @@ struct SgmOptions {
 
   Status Validate() const;
   int census_bits() const { return static_cast<int>((census_width * census_height - 1) / 2); }
+  // P2' for every absolute intensity step 0..255 (what the kernels and the FPGA look up).
+  void FillP2Table(uint8_t table[256]) const;
 };
 
 }  // namespace cairn

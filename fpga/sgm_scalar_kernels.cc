@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "fpga/sgm_kernels.h"
+#include "fpga/stereo_matcher_interface.h"
 
 namespace cairn {
 namespace {
@@ -42,9 +43,9 @@ void CostScalar(const uint32_t* left, const uint8_t* right_planes, int plane_str
   }
 }
 
-// One SGM recursion step: out[k] = C[k] + min(prev[k], prev[k+-1] + P1, min_prev + P2) - min_prev,
-// additions saturating at 255 (which only the sentinels reach). Returns min_k out[k].
-uint8_t Step(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uint8_t p1, uint8_t p2,
+}  // namespace
+
+uint8_t SgmPathStep(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uint8_t p1, uint8_t p2,
              int d_count, uint8_t* out) {
   const auto sat_add = [](uint8_t a, uint8_t b) {
     return static_cast<uint8_t>(std::min(a + b, 255));
@@ -60,12 +61,25 @@ uint8_t Step(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uint8_t p1
   return best;
 }
 
-void HorizontalScalar(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
+int SgmSubpixelOffset(int below, int at, int above) {
+  const int den = std::max(below, above) - at;
+  if (den <= 0) return 0;
+  const int num = (below - above) * (kDisparityScale / 2);
+  return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
+
+namespace {
+
+constexpr auto Step = SgmPathStep;
+
+// passes = 1: left to right only; 2: also right to left.
+void HorizontalPasses(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum,
+                      int passes) {
   const int d_count = g.disparities;
   uint8_t* a = scratch;
   uint8_t* b = scratch + g.block;
-  for (int pass = 0; pass < 2; ++pass) {
+  for (int pass = 0; pass < passes; ++pass) {
     std::fill(a, a + d_count, uint8_t{0});
     uint8_t min_prev = 0;
     int prev_x = pass == 0 ? 0 : g.width - 1;
@@ -79,6 +93,17 @@ void HorizontalScalar(const uint8_t* cost, const uint8_t* image_row, const SgmRo
       prev_x = x;
     }
   }
+}
+
+void HorizontalScalar(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                      const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
+  HorizontalPasses(cost, image_row, g, p2_table, p1, scratch, sum, 2);
+}
+
+void HorizontalForwardScalar(const uint8_t* cost, const uint8_t* image_row,
+                             const SgmRowGeometry& g, const uint8_t* p2_table, uint8_t p1,
+                             uint8_t* scratch, uint16_t* sum) {
+  HorizontalPasses(cost, image_row, g, p2_table, p1, scratch, sum, 1);
 }
 
 void VerticalScalar(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
@@ -148,8 +173,8 @@ void WtaScalar(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_perc
 }  // namespace
 
 const SgmKernels& ScalarSgmKernels() {
-  static const SgmKernels kernels{CensusScalar, CostScalar, HorizontalScalar, VerticalScalar,
-                                  WtaScalar};
+  static const SgmKernels kernels{CensusScalar,   CostScalar,     HorizontalScalar,
+                                  HorizontalForwardScalar, VerticalScalar, WtaScalar};
   return kernels;
 }
 

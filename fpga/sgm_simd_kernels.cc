@@ -168,6 +168,24 @@ void HorizontalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row, const S
   }
 }
 
+// The left-to-right path alone (raster_paths mode).
+template <class D8>
+void HorizontalForwardImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
+                           const SgmRowGeometry& g, const uint8_t* p2_table, uint8_t p1,
+                           uint8_t* scratch, uint16_t* sum) {
+  const int d_count = g.disparities;
+  uint8_t* a = scratch;
+  uint8_t* b = scratch + g.block;
+  std::fill(a, a + d_count, uint8_t{0});
+  uint8_t min_prev = 0;
+  for (int x = 0; x < g.width; ++x) {
+    const uint8_t p2 = p2_table[std::abs(image_row[x] - image_row[x > 0 ? x - 1 : x])];
+    uint16_t* s = sum + x * d_count;
+    min_prev = StepSimd<false>(d, cost + x * d_count, a, min_prev, p1, p2, d_count, b, s, s);
+    std::swap(a, b);
+  }
+}
+
 template <bool kStream, class D8>
 void VerticalImpl(D8 d, const uint8_t* cost, const uint8_t* image_row,
                   const uint8_t* prev_image_row, const SgmRowGeometry& g, int paths,
@@ -211,6 +229,18 @@ static void HorizontalSimd(const uint8_t* cost, const uint8_t* image_row, const 
     HorizontalImpl(full, cost, image_row, g, p2_table, p1, scratch, sum);
   } else {
     HorizontalImpl(hn::CappedTag<uint8_t, 16>(), cost, image_row, g, p2_table, p1, scratch, sum);
+  }
+}
+
+static void HorizontalForwardSimd(const uint8_t* cost, const uint8_t* image_row,
+                                  const SgmRowGeometry& g, const uint8_t* p2_table, uint8_t p1,
+                                  uint8_t* scratch, uint16_t* sum) {
+  const hn::ScalableTag<uint8_t> full;
+  if (g.disparities % static_cast<int>(hn::Lanes(full)) == 0) {
+    HorizontalForwardImpl(full, cost, image_row, g, p2_table, p1, scratch, sum);
+  } else {
+    HorizontalForwardImpl(hn::CappedTag<uint8_t, 16>(), cost, image_row, g, p2_table, p1, scratch,
+                          sum);
   }
 }
 
@@ -309,6 +339,7 @@ namespace {
 HWY_EXPORT(CensusSimd);
 HWY_EXPORT(CostSimd);
 HWY_EXPORT(HorizontalSimd);
+HWY_EXPORT(HorizontalForwardSimd);
 HWY_EXPORT(VerticalSimd);
 HWY_EXPORT(WtaSimd);
 HWY_EXPORT(TargetSimd);
@@ -323,6 +354,10 @@ void Cost(const uint32_t* left, const uint8_t* right_planes, int plane_stride, i
 void Horizontal(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
                 const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
   HWY_DYNAMIC_DISPATCH(HorizontalSimd)(cost, image_row, g, p2_table, p1, scratch, sum);
+}
+void HorizontalForward(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                       const uint8_t* p2_table, uint8_t p1, uint8_t* scratch, uint16_t* sum) {
+  HWY_DYNAMIC_DISPATCH(HorizontalForwardSimd)(cost, image_row, g, p2_table, p1, scratch, sum);
 }
 void Vertical(const uint8_t* cost, const uint8_t* image_row, const uint8_t* prev_image_row,
               const SgmRowGeometry& g, int paths, const uint8_t* p2_table, uint8_t p1,
@@ -339,7 +374,7 @@ void Wta(const uint16_t* sum, const SgmRowGeometry& g, int uniqueness_percent, u
 }  // namespace
 
 const SgmKernels& SimdSgmKernels() {
-  static const SgmKernels kernels{Census, Cost, Horizontal, Vertical, Wta};
+  static const SgmKernels kernels{Census, Cost, Horizontal, HorizontalForward, Vertical, Wta};
   return kernels;
 }
 

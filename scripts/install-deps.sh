@@ -19,6 +19,8 @@ packages=(
   systemd iproute2 can-utils util-linux file python3
   # dense stereo (fpga/): Google Highway SIMD
   libhwy-dev
+  # FPGA offload (fpga/rtl): cosimulation and synthesis check
+  verilator yosys
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)

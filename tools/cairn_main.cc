@@ -19,6 +19,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"stereo", "dense disparity of a stereo pair (SGM), written as PFM", RunStereo},
     {"stereo-eval", "score a disparity PFM against Middlebury/KITTI ground truth (JSON)", RunStereoEval},
     {"bench stereo", "time our SGM against OpenCV StereoSGBM side by side", RunBenchStereo},
+    {"bench fpga", "cosimulate one frame on the FPGA SGM core: cycles per pixel, clock, latency", RunBenchFpga},
     {"bench filter", "time the local reference filter (propagation, delayed updates, switches)", RunBenchFilter},
     {"graph solve", "batch-solve a g2o pose graph (file or multi-robot dir) and print costs", RunGraphSolve},
     {"graph replay", "feed a g2o graph vertex by vertex into the online SLAM graph, time each update", RunGraphReplay},

@@ -17,6 +17,7 @@ namespace cairn::tools {
 int RunStereo(const CommandArgs& args);
 int RunStereoEval(const CommandArgs& args);
 int RunBenchStereo(const CommandArgs& args);
+int RunBenchFpga(const CommandArgs& args);
 int RunBenchFilter(const CommandArgs& args);
 int RunGraphSolve(const CommandArgs& args);
 int RunGraphReplay(const CommandArgs& args);

@@ -30,8 +30,17 @@ expect_ok "$C" stereo "$M/im0.png" "$M/im1.png" --max-disparity 96 --min-dispari
 expect_ok "$C" stereo-eval --est "$T/moto.pfm" --gt "$M/disp0GT.pfm" --mask "$M/mask0nocc.png" --metric bad0.5
 expect_ok "$C" bench stereo --left "$M/im0.png" --right "$M/im1.png" --size 160x96 --max-disparity 32 --iterations 1
 grep -q 'opencv-sgbm-3way' "$T/out" && grep -q 'opencv-hh4' "$T/out" || { echo "FAIL: bench output"; exit 1; }
+# The cosimulated FPGA gives the same file as the CPU kernel in the FPGA mode (raster4 paths).
+expect_ok "$C" stereo "$D/im2.png" "$D/im6.png" --max-disparity 64 --backend fpga-sim --out "$T/cones-fpga.pfm"
+grep -q 'device cycles' "$T/out" || { echo "FAIL: no fpga-sim cycles"; exit 1; }
+expect_ok "$C" stereo "$D/im2.png" "$D/im6.png" --max-disparity 64 --paths raster4 --out "$T/cones-raster.pfm"
+cmp "$T/cones-fpga.pfm" "$T/cones-raster.pfm" || { echo "FAIL: fpga-sim differs from raster4"; exit 1; }
+expect_ok "$C" bench fpga --left "$M/im0.png" --right "$M/im1.png" --size 96x32 --max-disparity 64
+grep -q 'bit-exact vs golden (scalar raster_paths): yes' "$T/out" || { echo "FAIL: bench fpga"; cat "$T/out"; exit 1; }
 
 # Bad input.
+expect_fail "$C" stereo "$D/im2.png" "$D/im6.png" --max-disparity 64 --backend fpga-sim --census 9x7 --out "$T/x.pfm"
+expect_fail "$C" bench fpga --size 96x32 --max-disparity 48
 expect_fail "$C" stereo "$D/im2.png" "$D/missing.png" --max-disparity 64 --out "$T/x.pfm"
 expect_fail "$C" stereo "$D/im2.png" "$M/im1.png" --max-disparity 64 --out "$T/x.pfm"
 expect_fail "$C" stereo "$D/im2.png" "$D/im6.png" --max-disparity 50 --out "$T/x.pfm"

@@ -17,8 +17,10 @@
 
 #include "drivers/euroc_dataset.h"
 #include "fpga/disparity_evaluator.h"
+#include "fpga/fpga_stereo_matcher.h"
 #include "fpga/opencv_sgbm_matcher.h"
 #include "fpga/sgm_matcher.h"
+#include "fpga/simulated_stereo_device.h"
 #include "fpga/stereo_image_io.h"
 #include "fpga/stereo_rectifier.h"
 #include "tools/commands.h"
@@ -106,7 +108,12 @@ bool ParseSgmOptions(const ArgMap& a, SgmOptions* o) {
   long max_d = 0, min_d = 0, paths = 4, threads = 2;
   if (!ParseInt(a.Get("--max-disparity"), "--max-disparity", &max_d)) return false;
   if (!ParseInt(a.Get("--min-disparity", "0"), "--min-disparity", &min_d)) return false;
-  if (!ParseInt(a.Get("--paths", "4"), "--paths", &paths)) return false;
+  // raster4: the FPGA mode's paths (left, up-left, up, up-right), implied by --backend fpga-sim.
+  const std::string backend = a.Get("--backend", "simd");
+  o->raster_paths = a.Get("--paths") == "raster4" || backend == "fpga-sim";
+  if (a.Get("--paths") != "raster4" && !ParseInt(a.Get("--paths", "4"), "--paths", &paths)) {
+    return false;
+  }
   if (!ParseInt(a.Get("--threads", "2"), "--threads", &threads)) return false;
   if (max_d - min_d < 16 || (max_d - min_d) % 16 != 0 || max_d - min_d > 512) {
     std::fprintf(stderr,
@@ -123,9 +130,8 @@ bool ParseSgmOptions(const ArgMap& a, SgmOptions* o) {
   o->num_disparities = max_d - min_d;
   o->paths = paths;
   o->threads = threads;
-  const std::string backend = a.Get("--backend", "simd");
-  if (backend != "simd" && backend != "scalar") {
-    std::fprintf(stderr, "cairn: --backend must be simd or scalar\n");
+  if (backend != "simd" && backend != "scalar" && backend != "fpga-sim") {
+    std::fprintf(stderr, "cairn: --backend must be simd, scalar or fpga-sim\n");
     return false;
   }
   o->backend = backend == "simd" ? SgmBackend::kSimd : SgmBackend::kScalar;
@@ -174,7 +180,8 @@ double MedianMs(std::vector<double> v) {
 int RunStereo(const CommandArgs& args) {
   const char* usage =
       "usage: cairn stereo LEFT RIGHT --max-disparity N [--min-disparity M] [--calib EUROC_DIR] "
-      "[--paths 4|8] --out DISP.pfm [--png VIS.png] [--threads T] [--backend simd|scalar] "
+      "[--paths 4|8|raster4] --out DISP.pfm [--png VIS.png] [--threads T] "
+      "[--backend simd|scalar|fpga-sim] "
       "[--census WxH] [--fill] [--matcher sgm|opencv-3way|opencv-hh4] [--p1 P] [--p2 P] "
       "[--uniqueness PERCENT] [--speckle-size PIXELS]\n";
   const ArgMap a(args,
@@ -213,7 +220,13 @@ int RunStereo(const CommandArgs& args) {
   input.baseline_m = baseline;
   std::unique_ptr<StereoMatcher> matcher;
   const std::string which = a.Get("--matcher", "sgm");
-  if (which == "sgm") {
+  if (which == "sgm" && a.Get("--backend") == "fpga-sim") {
+    // The cycle-accurate model of the FPGA offload behind the real driver.
+    auto fpga = FpgaStereoMatcher::Create(options, std::make_unique<SimulatedStereoDevice>(),
+                                          std::chrono::seconds(60));
+    if (!fpga.ok()) return Fail(fpga.status());
+    matcher = std::move(*fpga);
+  } else if (which == "sgm") {
     auto sgm = SgmMatcher::Create(options);
     if (!sgm.ok()) return Fail(sgm.status());
     matcher = std::move(*sgm);
@@ -239,6 +252,9 @@ int RunStereo(const CommandArgs& args) {
   for (int16_t d : out.disparity) valid += d != kInvalidDisparity;
   std::printf("%s: %dx%d, %ld valid pixels (%.1f %%)\n", a.Get("--out").c_str(), out.width,
               out.height, valid, 100.0 * valid / static_cast<double>(out.disparity.size()));
+  if (const auto* fpga = dynamic_cast<const FpgaStereoMatcher*>(matcher.get())) {
+    std::printf("fpga-sim: %u device cycles\n", fpga->last_frame_cycles());
+  }
   return 0;
 }
 
