@@ -82,8 +82,9 @@ Status Cairnd::Prepare() {
     ground_truth_ = std::move(robot->ground_truth);
     sources_.push_back(std::move(robot->source));
   }
-  // A simulated robot's wheels come from the simulator (through the same CAN decoder).
-  if (options_.can.enabled && options_.source != SourceKind::kSim) {
+  // The CAN bus is a live device: a replay takes wheel odometry from its recording and a simulated
+  // robot from the simulator (through the same CAN decoder), never from the bus.
+  if (options_.can.enabled && options_.source == SourceKind::kLive) {
     sources_.push_back(std::make_unique<SocketCanWheelDriver>(options_.can));
   }
   if (sources_.empty()) {

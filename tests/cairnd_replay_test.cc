@@ -72,6 +72,17 @@ TEST_F(CairndReplayTest, ReplaysEveryImuSampleAndStereoPairInOrder) {
   EXPECT_EQ(again.exit_code, 0) << again.output;
 }
 
+// A robot profile's CAN bus is a live device: replaying with it must not wait on the bus.
+TEST_F(CairndReplayTest, RobotProfileReplaysToTheEndWithoutItsCanBus) {
+  const auto r = RunProcess({Cairnd(), "--config", testing::SourceDir() + "/configs/rover.yaml", "--replay",
+                             testing::EurocMicro(), "--out", out_, "--set", "replay.pacing=fast", "--set",
+                             "live.enabled=false", "--set", "recording.enabled=false"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue s = JsonValue::ParseFile(out_ + "/summary.json");
+  EXPECT_EQ(s["stop_reason"].string(), "end_of_data");
+  EXPECT_EQ(s["streams"]["stereo"]["count"].number(), 95);
+}
+
 TEST_F(CairndReplayTest, DeterministicReplayWritesIdenticalSummaries) {
   const std::string second = testing::FreshTempDir("cairnd_out2");
   ASSERT_EQ(Run(testing::EurocMicro(), out_).exit_code, 0);
