@@ -29,7 +29,8 @@ std::string MarkerRow(const SimMarker& m) {
 }
 
 Status WriteMarkers(const std::string& path, const std::vector<SimMarker>& markers) {
-  std::string text = "#id,size [m],p_x [m],p_y [m],p_z [m],q_w,q_x,q_y,q_z (placeholder codes, not tag36h11)\n";
+  // Ids are AprilTag 36h11 ids; size is the edge of the black border square.
+  std::string text = "#id,size [m],p_x [m],p_y [m],p_z [m],q_w,q_x,q_y,q_z\n";
   for (const SimMarker& m : markers) text += MarkerRow(m);
   FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) return IoError(path + ": cannot create");
