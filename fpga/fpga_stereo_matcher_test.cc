@@ -21,15 +21,8 @@ namespace {
 // The pair every test here matches.
 TestStereoPair Frame() { return TestStereoPair::Make(40, 12, 4, 9); }
 
-SgmOptions FpgaMode() {
-  SgmOptions o;
-  o.raster_paths = true;
-  o.num_disparities = 32;
-  return o;
-}
-
 std::vector<int16_t> Golden(const TestStereoPair& f) {
-  auto m = SgmMatcher::Create(FpgaMode());
+  auto m = SgmMatcher::Create(FpgaModeTestOptions());
   StereoMatcherOutput out;
   EXPECT_TRUE(m.ok() && (*m)->Match(f.input(), &out).ok());
   return out.disparity;
@@ -55,18 +48,18 @@ std::unique_ptr<FpgaStereoMatcher> OnSimulator(SimulatedStereoDevice** device,
                                                std::chrono::nanoseconds timeout) {
   auto dev = std::make_unique<SimulatedStereoDevice>();
   *device = dev.get();
-  auto m = FpgaStereoMatcher::Create(FpgaMode(), std::move(dev), timeout);
+  auto m = FpgaStereoMatcher::Create(FpgaModeTestOptions(), std::move(dev), timeout);
   EXPECT_TRUE(m.ok()) << m.status().ToString();
   return m.ok() ? std::move(*m) : nullptr;
 }
 
 TEST(FpgaStereoMatcherTest, AbsentOrForeignDevicesAreReported) {
-  auto gone = FpgaStereoMatcher::Create(FpgaMode(), std::make_unique<ConstantDevice>(0xFFFFFFFFu));
+  auto gone = FpgaStereoMatcher::Create(FpgaModeTestOptions(), std::make_unique<ConstantDevice>(0xFFFFFFFFu));
   EXPECT_EQ(gone.status().code(), StatusCode::kUnavailable) << gone.status().ToString();
-  auto other = FpgaStereoMatcher::Create(FpgaMode(), std::make_unique<ConstantDevice>(0x12345678u));
+  auto other = FpgaStereoMatcher::Create(FpgaModeTestOptions(), std::make_unique<ConstantDevice>(0x12345678u));
   EXPECT_EQ(other.status().code(), StatusCode::kNotFound);
   EXPECT_NE(other.status().message().find("0x12345678"), std::string::npos);
-  auto none = FpgaStereoMatcher::Create(FpgaMode(), nullptr);
+  auto none = FpgaStereoMatcher::Create(FpgaModeTestOptions(), nullptr);
   EXPECT_EQ(none.status().code(), StatusCode::kUnavailable);
   auto uio = UioStereoDevice::Open("/dev/uio-cairn-test-absent");
   EXPECT_FALSE(uio.ok());
@@ -79,23 +72,23 @@ TEST(FpgaStereoMatcherTest, RejectsOptionsTheCoreCannotRun) {
     auto m = FpgaStereoMatcher::Create(o, std::make_unique<SimulatedStereoDevice>());
     EXPECT_EQ(m.status().code(), StatusCode::kInvalidArgument) << what;
   };
-  SgmOptions o = FpgaMode();
+  SgmOptions o = FpgaModeTestOptions();
   o.raster_paths = false;
   reject(o, "full path set");
-  o = FpgaMode();
+  o = FpgaModeTestOptions();
   o.census_width = 9;
   o.census_height = 7;
   reject(o, "9x7 census");
-  o = FpgaMode();
+  o = FpgaModeTestOptions();
   o.min_disparity = 4;
   reject(o, "min disparity");
-  o = FpgaMode();
+  o = FpgaModeTestOptions();
   o.num_disparities = 48;
   reject(o, "not a multiple of the lanes");
   o.num_disparities = 256;
   reject(o, "more than the core's maximum");
   // Too wide for the core is not the caller's fault (the CPU takes it): OutOfRange.
-  auto m = FpgaStereoMatcher::Create(FpgaMode(), std::make_unique<SimulatedStereoDevice>());
+  auto m = FpgaStereoMatcher::Create(FpgaModeTestOptions(), std::make_unique<SimulatedStereoDevice>());
   ASSERT_TRUE(m.ok());
   std::vector<uint8_t> wide(2000 * 4, 0);
   StereoMatcherInput in;

@@ -17,13 +17,6 @@ namespace {
 // The pair every test here matches.
 TestStereoPair Frame() { return TestStereoPair::Make(36, 10, 6, 17); }
 
-SgmOptions FpgaMode() {
-  SgmOptions o;
-  o.raster_paths = true;
-  o.num_disparities = 32;
-  return o;
-}
-
 StereoBackendOptions Backend(StereoBackend b) {
   StereoBackendOptions o;
   o.backend = b;
@@ -46,7 +39,7 @@ StereoBackendSwitch::DeviceOpener Simulated(SimulatedStereoDevice** handle = nul
 }
 
 std::vector<int16_t> Cpu(const TestStereoPair& f) {
-  auto m = SgmMatcher::Create(FpgaMode());
+  auto m = SgmMatcher::Create(FpgaModeTestOptions());
   StereoMatcherOutput out;
   EXPECT_TRUE(m.ok() && (*m)->Match(f.input(), &out).ok());
   return out.disparity;
@@ -54,7 +47,7 @@ std::vector<int16_t> Cpu(const TestStereoPair& f) {
 
 TEST(StereoBackendSwitchTest, CpuNeverOpensTheDevice) {
   bool opened = false;
-  auto s = StereoBackendSwitch::Create(Backend(StereoBackend::kCpu), FpgaMode(), [&opened]() {
+  auto s = StereoBackendSwitch::Create(Backend(StereoBackend::kCpu), FpgaModeTestOptions(), [&opened]() {
     opened = true;
     return Expected<std::unique_ptr<StereoDevice>>(NotFoundError("x"));
   });
@@ -71,7 +64,7 @@ TEST(StereoBackendSwitchTest, CpuNeverOpensTheDevice) {
 TEST(StereoBackendSwitchTest, FpgaAndAutoUseThePresentDeviceWithTheCpuResult) {
   const TestStereoPair f = Frame();
   for (StereoBackend b : {StereoBackend::kFpga, StereoBackend::kAuto}) {
-    auto s = StereoBackendSwitch::Create(Backend(b), FpgaMode(), Simulated());
+    auto s = StereoBackendSwitch::Create(Backend(b), FpgaModeTestOptions(), Simulated());
     ASSERT_TRUE(s.ok()) << s.status().ToString();
     EXPECT_TRUE((*s)->fpga_active());
     EXPECT_EQ((*s)->name(), "fpga");
@@ -86,7 +79,7 @@ TEST(StereoBackendSwitchTest, AbsentDeviceFallsBackWithOneWarningOnlyWhenAskedFo
   const TestStereoPair f = Frame();
   std::vector<std::string> warnings;
   const auto warn = [&warnings](const std::string& m) { warnings.push_back(m); };
-  auto fpga = StereoBackendSwitch::Create(Backend(StereoBackend::kFpga), FpgaMode(), Absent(), warn);
+  auto fpga = StereoBackendSwitch::Create(Backend(StereoBackend::kFpga), FpgaModeTestOptions(), Absent(), warn);
   ASSERT_TRUE(fpga.ok());
   EXPECT_FALSE((*fpga)->fpga_active());
   EXPECT_EQ((*fpga)->fpga_failures(), 1u);
@@ -98,7 +91,7 @@ TEST(StereoBackendSwitchTest, AbsentDeviceFallsBackWithOneWarningOnlyWhenAskedFo
 
   warnings.clear();
   auto automatic =
-      StereoBackendSwitch::Create(Backend(StereoBackend::kAuto), FpgaMode(), Absent(), warn);
+      StereoBackendSwitch::Create(Backend(StereoBackend::kAuto), FpgaModeTestOptions(), Absent(), warn);
   ASSERT_TRUE(automatic.ok());
   EXPECT_FALSE((*automatic)->fpga_active());
   EXPECT_EQ((*automatic)->fpga_failures(), 0u);
@@ -107,7 +100,7 @@ TEST(StereoBackendSwitchTest, AbsentDeviceFallsBackWithOneWarningOnlyWhenAskedFo
 }
 
 TEST(StereoBackendSwitchTest, OptionsTheCoreCannotRun) {
-  SgmOptions full = FpgaMode();
+  SgmOptions full = FpgaModeTestOptions();
   full.raster_paths = false;
   auto fpga = StereoBackendSwitch::Create(Backend(StereoBackend::kFpga), full, Simulated());
   EXPECT_EQ(fpga.status().code(), StatusCode::kInvalidArgument);
@@ -122,7 +115,7 @@ TEST(StereoBackendSwitchTest, FailureMidRunSwitchesToTheCpuOnceAndKeepsRunning) 
   std::vector<std::string> warnings;
   SimulatedStereoDevice* dev = nullptr;
   auto s = StereoBackendSwitch::Create(
-      Backend(StereoBackend::kFpga), FpgaMode(), Simulated(&dev),
+      Backend(StereoBackend::kFpga), FpgaModeTestOptions(), Simulated(&dev),
       [&warnings](const std::string& m) { warnings.push_back(m); });
   ASSERT_TRUE(s.ok());
   StereoMatcherOutput out;

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "fpga/sgm_options.h"
 #include "fpga/stereo_matcher_interface.h"
 
 namespace cairn {
@@ -43,5 +44,13 @@ struct TestStereoPair {
     return in;
   }
 };
+
+// The FPGA mode (raster paths) with the disparity range the offload tests use.
+inline SgmOptions FpgaModeTestOptions() {
+  SgmOptions o;
+  o.raster_paths = true;
+  o.num_disparities = 32;
+  return o;
+}
 
 }  // namespace cairn
