@@ -44,6 +44,7 @@ void Cairnd::BlockTerminationSignals() {
 }
 
 Status Cairnd::Prepare() {
+  wheel_odometry_ = options_.can.enabled;  // a simulated robot overrides it below
   if (options_.source == SourceKind::kReplay) {
     if (options_.replay.dataset.empty()) {
       return InvalidArgumentError(config_path_ + ": replay.dataset is empty; give a dataset with --replay DIR");
@@ -79,6 +80,7 @@ Status Cairnd::Prepare() {
     stereo_calibration_ = robot->stereo;
     imu_calibration_ = robot->imu;
     camera_rate_hz_ = robot->camera_rate_hz;
+    wheel_odometry_ = robot->has_wheels;
     ground_truth_ = std::move(robot->ground_truth);
     sources_.push_back(std::move(robot->source));
   }
@@ -121,9 +123,7 @@ int Cairnd::Run() {
     EstimationSetup setup;
     setup.imu = *imu_calibration_;
     setup.stereo = *stereo_calibration_;
-    // A simulated rover's wheels speak the configured CAN layout too.
-    const bool wheels = options_.can.enabled || (options_.source == SourceKind::kSim && options_.robot.kind == RobotKind::kRover);
-    if (wheels) setup.wheels = CanWheelDecoder(options_.can).calibration();
+    if (wheel_odometry_) setup.wheels = CanWheelDecoder(options_.can).calibration();
     setup.filter = options_.filter;
     setup.vo = options_.vo;
     setup.frame_switch = options_.frame_switch;

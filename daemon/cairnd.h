@@ -37,6 +37,8 @@ class Cairnd {
   std::optional<StereoCalibration> stereo_calibration_;
   std::optional<ImuCalibration> imu_calibration_;
   double camera_rate_hz_ = 0.0;
+  // Wheel odometry arrives in the configured CAN layout (a bus, a recording of one, a simulated rover).
+  bool wheel_odometry_ = false;
   // Simulated runs: the robot's true trajectory, written as ground_truth.tum for evaluation.
   std::optional<Trajectory> ground_truth_;
   std::vector<std::unique_ptr<SensorSourceInterface>> sources_;

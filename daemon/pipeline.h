@@ -92,7 +92,7 @@ class Pipeline final : public SensorSink {
   // collect statistics.
   Status EnableEstimation(const EstimationSetup& setup);
   // Asks the filter to switch its frame of reference (the path submap partitioning uses). From
-  // the vo thread (the placeholder policy) or, later, the mapping thread; one producer.
+  // the vo thread (the interim distance/sigma policy) or, later, the mapping thread; one producer.
   void RequestFrameSwitch(const FrameSwitchRequest& request);
   // Starts the stage threads.
   void Start();

@@ -57,6 +57,7 @@ Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const 
   robot.stereo = r.stereo;
   robot.imu = r.imu;
   robot.camera_rate_hz = r.camera_rate_hz;
+  robot.has_wheels = r.kind == sim::SimRobotKind::kRover;
   robot.ground_truth.frame = "world";
   for (const sim::ImuTruth& s : shared->ImuStream(index)) {
     robot.ground_truth.poses.push_back({s.sample.time, s.state.T_world_body});

@@ -17,6 +17,7 @@ struct SimulatedRobot {
   StereoCalibration stereo;
   ImuCalibration imu;
   double camera_rate_hz = 0.0;
+  bool has_wheels = false;  // its wheel CAN frames use the configured CAN layout
   Trajectory ground_truth;  // T_world_body at every IMU sample, frame "world"
 };
 

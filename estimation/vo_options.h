@@ -1,6 +1,6 @@
 #pragma once
 // Options of the keyframe stereo visual odometry (estimation/keyframe_visual_odometry.h) and of
-// the placeholder frame-switch policy that stands in for submap partitioning (thesis 5.1.3).
+// the interim frame-switch policy (7 m / 0.1 m sigma) used until submap partitioning drives it (thesis 5.1.3).
 
 #include <cstdint>
 

@@ -76,7 +76,8 @@ TEST_F(CairndReplayTest, ReplaysEveryImuSampleAndStereoPairInOrder) {
 TEST_F(CairndReplayTest, RobotProfileReplaysToTheEndWithoutItsCanBus) {
   const auto r = RunProcess({Cairnd(), "--config", testing::SourceDir() + "/configs/rover.yaml", "--replay",
                              testing::EurocMicro(), "--out", out_, "--set", "replay.pacing=fast", "--set",
-                             "live.enabled=false", "--set", "recording.enabled=false"});
+                             "live.enabled=false", "--set", "recording.enabled=false", "--set",
+                             "replay.deterministic=true"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue s = JsonValue::ParseFile(out_ + "/summary.json");
   EXPECT_EQ(s["stop_reason"].string(), "end_of_data");
