@@ -13,6 +13,8 @@ packages=(
   libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev nodejs
   # SLAM graph back-end
   libceres-dev
+  # local mapping: probabilistic voxel submaps
+  liboctomap-dev
   # AprilTag 36h11 code words (simulator markers) and teammate detection
   libapriltag-dev
   # tools used by tests and scripts
