@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "drivers/simulator/sim_random.h"
 
@@ -31,7 +32,13 @@ struct Object {
   const SimMarker* marker = nullptr;
   float albedo = 0.3f;
   int u0 = 0, u1 = -1, v0 = 0, v1 = -1;  // pixel rectangle that may see it
+  Eigen::Vector3d o_local = Eigen::Vector3d::Zero();  // the camera centre in the object's frame
 };
+
+// Pixels share one conservative terrain traversal per tile of kTile x kTile pixels, or half that
+// for wide-angle cameras (below kWideFocal px), whose pixels spread faster.
+constexpr int kTile = 8;
+constexpr double kWideFocal = 700.0;
 
 // Distance along the ray to a box in its own frame (slab test) and the hit face normal.
 double HitBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& h,
@@ -65,6 +72,46 @@ float MarkerAlbedo(const SimMarker& m, double x, double y) {
   return (m.bits >> (35 - bit)) & 1 ? 0.85f : 0.04f;
 }
 
+// One image row's rays, structure of arrays: the world direction, the camera ray's z (inverse
+// length of (x, y, 1)), the horizontal length and its inverse (0 for vertical rays), and the
+// horizontal components in grid cells with their inverses (used only where not zero).
+struct RayRow {
+  std::vector<double> dx, dy, dz, inv_len, horizontal, inv_h, gdx, gdy, inv_gdx, inv_gdy;
+};
+
+// Straight-line arithmetic over plain arrays, so that the compiler vectorizes the square roots
+// and divisions (the pointers are parameters: restrict-qualified locals do not convince it).
+void SetUpRays(int w, const double* __restrict xs, double yy1, const double* r0, const double* base,
+               double inv_res, double* __restrict rdx, double* __restrict rdy, double* __restrict rdz,
+               double* __restrict rlen, double* __restrict rhor, double* __restrict rih, double* __restrict rgx,
+               double* __restrict rgy, double* __restrict rigx, double* __restrict rigy) {
+  const double ax = r0[0], ay = r0[1], az = r0[2], bx = base[0], by = base[1], bz = base[2];
+  for (int u = 0; u < w; ++u) {
+    const double xc = xs[u];
+    const double inv_len = 1.0 / std::sqrt(xc * xc + yy1);
+    const double dx = (ax * xc + bx) * inv_len, dy = (ay * xc + by) * inv_len, dz = (az * xc + bz) * inv_len;
+    const double horizontal = std::sqrt(dx * dx + dy * dy);
+    const double inv_h = 1.0 / std::max(horizontal, 1e-9);
+    rdx[u] = dx;
+    rdy[u] = dy;
+    rdz[u] = dz;
+    rlen[u] = inv_len;
+    rhor[u] = horizontal;
+    rih[u] = horizontal > 1e-9 ? inv_h : 0.0;
+    rgx[u] = dx * inv_res;
+    rgy[u] = dy * inv_res;
+    rigx[u] = 1.0 / (dx * inv_res);
+    rigy[u] = 1.0 / (dy * inv_res);
+  }
+}
+
+void SetUpRays(int w, const double* xs, double yc, const Eigen::Vector3d& r0, const Eigen::Vector3d& row_base,
+               double inv_res, RayRow* r) {
+  SetUpRays(w, xs, yc * yc + 1.0, r0.data(), row_base.data(), inv_res, r->dx.data(), r->dy.data(), r->dz.data(),
+            r->inv_len.data(), r->horizontal.data(), r->inv_h.data(), r->gdx.data(), r->gdy.data(),
+            r->inv_gdx.data(), r->inv_gdy.data());
+}
+
 }  // namespace
 
 void RenderScene::AddRobot(const SimRobot& robot, const Eigen::Isometry3d& T_world_body) {
@@ -92,21 +139,30 @@ void CameraRenderer::ApplyNoise(const std::vector<float>& signal, int width, con
   const auto& gauss = GaussTable();
   image->resize(signal.size());
   const size_t w = static_cast<size_t>(width);
+  std::vector<float> g(w);
+  const double read_var = options.read_noise * options.read_noise, shot = options.shot_noise;
   for (size_t row = 0; row * w < signal.size(); ++row) {
+    // One stream per row: 12 random bits per pixel pick a standard normal value from the table.
     SimRandom rng = SimRandom::Stream(noise_seed, row);
     uint64_t bits = 0;
     int bits_left = 0;
-    for (size_t i = row * w; i < (row + 1) * w; ++i) {
+    for (size_t i = 0; i < w; ++i) {
       if (bits_left < 12) {
         bits = rng.Next();
         bits_left = 64;
       }
-      const float g = gauss[bits & 4095];
+      g[i] = gauss[bits & 4095];
       bits >>= 12;
       bits_left -= 12;
-      const double sigma = std::sqrt(options.read_noise * options.read_noise + options.shot_noise * signal[i]);
-      const double value = std::clamp(signal[i] + sigma * g, 0.0, 255.0);
-      (*image)[i] = static_cast<uint8_t>(value + 0.5);
+    }
+    // Read noise plus shot noise, then quantization (vectorizable).
+    const float* __restrict s = signal.data() + row * w;
+    uint8_t* __restrict out = image->data() + row * w;
+    const float* __restrict gp = g.data();
+    for (size_t i = 0; i < w; ++i) {
+      const double sigma = std::sqrt(read_var + shot * s[i]);
+      const double value = std::min(std::max(s[i] + sigma * gp[i], 0.0), 255.0);
+      out[i] = static_cast<uint8_t>(value + 0.5);
     }
   }
 }
@@ -115,33 +171,60 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
                                   const Eigen::Isometry3d& T_world_cam, const RenderOptions& options,
                                   std::vector<float>* out, std::vector<float>* depth) {
   const int w = k.width, h = k.height;
-  out->assign(static_cast<size_t>(w) * static_cast<size_t>(h), 0.0f);
+  out->resize(static_cast<size_t>(w) * static_cast<size_t>(h));  // every pixel is written below
   if (depth != nullptr) depth->assign(out->size(), 0.0f);
   const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
+  const Eigen::Matrix3d R = T_world_cam.linear();
+  const Eigen::Vector3d origin = T_world_cam.translation();
 
-  // Objects with the pixel rectangle their bounding sphere can cover.
+  // Objects with the pixel rectangle that can see them: the bounds of the projection of the part
+  // of their box in front of the camera (a box reaching behind the camera is unbounded towards
+  // the side where it crosses the camera's plane).
   std::vector<Object> objects;
   auto add = [&](const Eigen::Isometry3d& T_world_obj, const Eigen::Vector3d& half, bool marker,
                  const SimMarker* m, float albedo) {
     Object ob{T_world_obj.inverse(), half, marker, m, albedo};
-    const Eigen::Vector3d c = T_cam_world * T_world_obj.translation();
-    const double r = half.norm() + 1e-3;
-    if (c.z() + r <= 0.0) return;  // behind the camera
-    if (c.z() - r <= 0.01) {
-      ob.u0 = 0; ob.u1 = w - 1; ob.v0 = 0; ob.v1 = h - 1;
-    } else {
-      double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
-      for (int i = 0; i < 8; ++i) {
-        const Eigen::Vector3d p = c + r * Eigen::Vector3d(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
-        const double u = k.fx * p.x() / p.z() + k.cx, v = k.fy * p.y() / p.z() + k.cy;
-        umin = std::min(umin, u); umax = std::max(umax, u);
-        vmin = std::min(vmin, v); vmax = std::max(vmax, v);
-      }
-      ob.u0 = std::max(0, static_cast<int>(std::floor(umin)));
-      ob.u1 = std::min(w - 1, static_cast<int>(std::ceil(umax)));
-      ob.v0 = std::max(0, static_cast<int>(std::floor(vmin)));
-      ob.v1 = std::min(h - 1, static_cast<int>(std::ceil(vmax)));
+    ob.o_local = ob.T_obj_world * origin;
+    const Eigen::Isometry3d T_cam_obj = T_cam_world * T_world_obj;
+    const Eigen::Vector3d pad = half + Eigen::Vector3d::Constant(1e-3);
+    std::array<Eigen::Vector3d, 8> c;
+    for (int i = 0; i < 8; ++i) {
+      c[static_cast<size_t>(i)] = T_cam_obj * Eigen::Vector3d(i & 1 ? pad.x() : -pad.x(), i & 2 ? pad.y() : -pad.y(),
+                                                              i & 4 ? pad.z() : -pad.z());
     }
+    double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
+    bool in_front = false;
+    for (const Eigen::Vector3d& p : c) {
+      if (p.z() <= 0.0) continue;
+      in_front = true;
+      const double u = k.fx * p.x() / p.z() + k.cx, v = k.fy * p.y() / p.z() + k.cy;
+      umin = std::min(umin, u); umax = std::max(umax, u);
+      vmin = std::min(vmin, v); vmax = std::max(vmax, v);
+    }
+    if (!in_front) return;  // wholly behind the camera
+    for (int i = 0; i < 8; ++i) {
+      for (int bit = 1; bit < 8; bit <<= 1) {
+        const int j = i | bit;
+        if (j == i) continue;
+        const Eigen::Vector3d& a = c[static_cast<size_t>(i)];
+        const Eigen::Vector3d& b = c[static_cast<size_t>(j)];
+        if ((a.z() > 0.0) == (b.z() > 0.0)) continue;
+        // The edge crosses the camera's plane at q: points just in front of it project towards
+        // infinity in the direction of q's (x, y).
+        const Eigen::Vector3d q = a + (b - a) * (a.z() / (a.z() - b.z()));
+        constexpr double kTiny = 1e-9;
+        if (q.x() > -kTiny) umax = kInf;
+        if (q.x() < kTiny) umin = -kInf;
+        if (q.y() > -kTiny) vmax = kInf;
+        if (q.y() < kTiny) vmin = -kInf;
+      }
+    }
+    const double lo_u = std::max(umin, -1.0), hi_u = std::min(umax, static_cast<double>(w));
+    const double lo_v = std::max(vmin, -1.0), hi_v = std::min(vmax, static_cast<double>(h));
+    ob.u0 = std::max(0, static_cast<int>(std::floor(lo_u)) - 1);
+    ob.u1 = std::min(w - 1, static_cast<int>(std::ceil(hi_u)) + 1);
+    ob.v0 = std::max(0, static_cast<int>(std::floor(lo_v)) - 1);
+    ob.v1 = std::min(h - 1, static_cast<int>(std::ceil(hi_v)) + 1);
     if (ob.u0 <= ob.u1 && ob.v0 <= ob.v1) objects.push_back(ob);
   };
   for (const SimBox& b : scene.boxes) add(b.T_body_box, b.half_extent, false, nullptr, b.albedo);
@@ -150,53 +233,201 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
   }
 
   const double scale = options.gain * options.exposure * 255.0;
-  const Eigen::Matrix3d R = T_world_cam.linear();
-  const Eigen::Vector3d origin = T_world_cam.translation();
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const Eigen::Vector3d ray_cam = Eigen::Vector3d((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0).normalized();
-      const Eigen::Vector3d dir = R * ray_cam;
-      double t_best = options.max_range;
-      double albedo = 0.0;
-      Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
-      bool hit = false;
-      for (const Object& ob : objects) {
-        if (u < ob.u0 || u > ob.u1 || v < ob.v0 || v > ob.v1) continue;
-        const Eigen::Vector3d o = ob.T_obj_world * origin, d = ob.T_obj_world.linear() * dir;
-        if (ob.is_marker) {
-          if (d.z() >= 0.0 || o.z() <= 0.0) continue;  // seen from behind or edge-on
-          const double t = -o.z() / d.z();
-          const Eigen::Vector3d p = o + t * d;
-          if (t >= t_best || std::abs(p.x()) > ob.half_extent.x() || std::abs(p.y()) > ob.half_extent.y()) continue;
-          t_best = t;
-          albedo = MarkerAlbedo(*ob.marker, p.x(), p.y());
-          normal = ob.T_obj_world.linear().transpose() * Eigen::Vector3d::UnitZ();
-          hit = true;
-        } else {
-          Eigen::Vector3d n_local;
-          const double t = HitBox(o, d, ob.half_extent, &n_local);
-          if (t >= t_best) continue;
-          t_best = t;
-          albedo = ob.albedo;
-          normal = ob.T_obj_world.linear().transpose() * n_local;
-          hit = true;
+  const Eigen::Vector3d& sun = scene.sun_direction;
+  const Terrain& terrain = *scene.terrain;
+  // Ray directions: the world direction of pixel (u, v) is (r0 x_u + r1 y_v + r2) / |(x_u, y_v, 1)|.
+  std::vector<double> col_x(static_cast<size_t>(w)), row_y(static_cast<size_t>(h));
+  for (int u = 0; u < w; ++u) col_x[static_cast<size_t>(u)] = (u - k.cx) / k.fx;
+  for (int v = 0; v < h; ++v) row_y[static_cast<size_t>(v)] = (v - k.cy) / k.fy;
+  const Eigen::Vector3d r0 = R.col(0), r1 = R.col(1), r2 = R.col(2);
+  auto world_ray = [&](double x, double y) {
+    return Eigen::Vector3d((r0 * x + r1 * y + r2) * (1.0 / std::sqrt(x * x + y * y + 1.0)));
+  };
+
+  // Per tile of pixels, one conservative traversal for the tile's bundle of rays:
+  // none of them meets the terrain before the tile's clear distance.
+  const int tile = std::min(k.fx, k.fy) < kWideFocal ? kTile / 2 : kTile;
+  const int tiles_x = (w + tile - 1) / tile;
+  std::vector<double> tile_clear(static_cast<size_t>(tiles_x));
+  int tile_row = -1;  // the row of tiles that tile_clear is for; its entries are computed on demand
+  auto tile_clear_at = [&](int u) {
+    const int tv0 = tile_row * tile, tv1 = std::min(h, tv0 + tile) - 1;
+    const size_t tx = static_cast<size_t>(u / tile);
+    if (!(tile_clear[tx] >= 0.0)) {
+      const int tu0 = static_cast<int>(tx) * tile, tu1 = std::min(w, tu0 + tile) - 1;
+      const double xm = 0.5 * (col_x[static_cast<size_t>(tu0)] + col_x[static_cast<size_t>(tu1)]);
+      const double ym = 0.5 * (row_y[static_cast<size_t>(tv0)] + row_y[static_cast<size_t>(tv1)]);
+      const Eigen::Vector3d centre = world_ray(xm, ym);
+      double spread = 0.0;
+      for (const int cu : {tu0, tu1}) {
+        for (const int cv : {tv0, tv1}) {
+          spread = std::max(spread, (world_ray(col_x[static_cast<size_t>(cu)], row_y[static_cast<size_t>(cv)]) - centre).norm());
         }
       }
-      const TerrainHit th = scene.terrain->Raycast(origin, dir, t_best);
-      if (th.t > 0.0) {
-        t_best = th.t;
-        const Eigen::Vector3d p = origin + th.t * dir;
-        albedo = scene.terrain->Albedo(p.x(), p.y());
-        normal = th.normal;
-        hit = true;
+      tile_clear[tx] = terrain.ClearDistance(origin, centre, spread, options.max_range);
+    }
+    return tile_clear[tx];
+  };
+
+  // The column bound. The ray of pixel B and the ray of a pixel A in a row below it, compared at
+  // equal horizontal distance rho, are rho |hB - hA| apart sideways (h: unit horizontal
+  // directions) and rho (tanB - tanA) apart in height (tan: slope of the ray). Where the height
+  // gap outgrows what the steepest terrain slope can make up over the sideways gap, B stays above
+  // the terrain for as long as A did: up to A's hit. A is the pixel straight below B in the image
+  // when the camera looks ahead; a steep camera's vertical planes fan out from the nadir's image,
+  // so A is then taken up to kBelowRows rows down along that direction.
+  const double slope = terrain.max_slope();
+  const bool origin_on_grid =
+      std::abs(origin.x()) <= terrain.half_size() && std::abs(origin.y()) <= terrain.half_size();
+  struct Column {
+    double rho = -1.0;  // horizontal distance of the pixel's terrain hit; < 0: none
+    double tan_elevation = 0.0, hx = 0.0, hy = 0.0;
+  };
+  constexpr int kBelowRows = 4;
+  std::vector<Column> history(static_cast<size_t>(kBelowRows + 1) * static_cast<size_t>(w));
+  auto history_row = [&](int row) {
+    return history.data() + static_cast<size_t>(row % (kBelowRows + 1)) * static_cast<size_t>(w);
+  };
+  // The nadir in camera coordinates: at pixel (u, v) the image of "down" points along
+  // (fx (nx - x nz), fy (ny - y nz)) for the camera ray (x, y, 1).
+  const Eigen::Vector3d nadir = -R.row(2).transpose();
+
+  // One image row at a time, bottom-up (so that the pixels below are done), in spans of up to
+  // kSpan pixels that keep their working arrays in the first-level cache, and in passes: ray set-up
+  // (divisions and square roots, vectorized), objects and search bounds, the search, shading.
+  constexpr int kSpan = 128;
+  RayRow rays;
+  for (auto* vec : {&rays.dx, &rays.dy, &rays.dz, &rays.inv_len, &rays.horizontal, &rays.inv_h, &rays.gdx,
+                    &rays.gdy, &rays.inv_gdx, &rays.inv_gdy}) {
+    vec->resize(kSpan);
+  }
+  enum class Seen : uint8_t { kSky, kTerrain, kObject };
+  std::array<Seen, kSpan> seen{};
+  std::array<Terrain::CellHit, kSpan> hits{};
+  std::array<double, kSpan> object_signal{}, shade{}, t_max{}, t_start{}, hit_x{}, hit_y{};
+  std::array<float, kSpan> albedo{};
+  bool found[kSpan] = {};
+  std::vector<const Object*> row_objects;
+  const double inv_res = 1.0 / terrain.resolution();
+  const double gox = (origin.x() + terrain.half_size()) * inv_res, goy = (origin.y() + terrain.half_size()) * inv_res;
+  for (int v = h - 1; v >= 0; --v) {
+    if (v / tile != tile_row) {
+      tile_row = v / tile;
+      std::fill(tile_clear.begin(), tile_clear.end(), -1.0);
+    }
+    const double yc = row_y[static_cast<size_t>(v)];
+    const Eigen::Vector3d row_base = r1 * yc + r2;
+    Column* current = history_row(v);
+    const Column* below_rows[kBelowRows + 1] = {nullptr};
+    const int rows_below = std::min(kBelowRows, h - 1 - v);
+    for (int m = 1; m <= rows_below; ++m) below_rows[m] = history_row(v + m);
+    row_objects.clear();
+    for (const Object& ob : objects) {
+      if (v >= ob.v0 && v <= ob.v1) row_objects.push_back(&ob);
+    }
+    const double down_v = k.fy * (nadir.y() - yc * nadir.z());
+    float* out_row = out->data() + static_cast<size_t>(v) * static_cast<size_t>(w);
+    float* depth_row = depth != nullptr ? depth->data() + static_cast<size_t>(v) * static_cast<size_t>(w) : nullptr;
+    for (int u0 = 0; u0 < w; u0 += kSpan) {
+      const int n = std::min(kSpan, w - u0);
+      SetUpRays(n, col_x.data() + u0, yc, r0, row_base, inv_res, &rays);
+      // Objects first (they bound the terrain search), then where the terrain search starts.
+      for (int i = 0; i < n; ++i) {
+        const int u = u0 + i;
+        const size_t j = static_cast<size_t>(i);
+        const Eigen::Vector3d dir(rays.dx[j], rays.dy[j], rays.dz[j]);
+        double t_best = options.max_range;
+        seen[j] = Seen::kSky;
+        if (!row_objects.empty()) {
+          double object_albedo = 0.0;
+          Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+          for (const Object* obp : row_objects) {
+            const Object& ob = *obp;
+            if (u < ob.u0 || u > ob.u1) continue;
+            const Eigen::Vector3d& o = ob.o_local;
+            const Eigen::Vector3d d = ob.T_obj_world.linear() * dir;
+            if (ob.is_marker) {
+              if (d.z() >= 0.0 || o.z() <= 0.0) continue;  // seen from behind or edge-on
+              const double t = -o.z() / d.z();
+              const Eigen::Vector3d p = o + t * d;
+              if (t >= t_best || std::abs(p.x()) > ob.half_extent.x() || std::abs(p.y()) > ob.half_extent.y()) continue;
+              t_best = t;
+              object_albedo = MarkerAlbedo(*ob.marker, p.x(), p.y());
+              normal = ob.T_obj_world.linear().transpose() * Eigen::Vector3d::UnitZ();
+              seen[j] = Seen::kObject;
+            } else {
+              Eigen::Vector3d n_local;
+              const double t = HitBox(o, d, ob.half_extent, &n_local);
+              if (t >= t_best) continue;
+              t_best = t;
+              object_albedo = ob.albedo;
+              normal = ob.T_obj_world.linear().transpose() * n_local;
+              seen[j] = Seen::kObject;
+            }
+          }
+          if (seen[j] == Seen::kObject) {
+            object_signal[j] = scale * object_albedo * (options.ambient + std::max(0.0, normal.dot(sun)));
+          }
+        }
+        t_max[j] = t_best;
+        const double inv_h = rays.inv_h[j];
+        const double tan_e = dir.z() * inv_h, hx = dir.x() * inv_h, hy = dir.y() * inv_h;
+        bool bounded = false;
+        if (down_v > 0.0 && inv_h > 0.0 && origin_on_grid) {
+          const double down_u = k.fx * (nadir.x() - col_x[static_cast<size_t>(u)] * nadir.z());
+          for (int m = 1; m <= rows_below; ++m) {
+            const double shift = m * down_u;  // columns to the pixel m rows down, times down_v
+            const int ua = 2.0 * std::abs(shift) < down_v ? u : u + static_cast<int>(std::lround(shift / down_v));
+            if (ua < 0 || ua >= w) break;
+            const Column& a = below_rows[m][ua];
+            if (!(a.rho > 0.0)) continue;
+            const double rise = tan_e - a.tan_elevation;
+            const double ex = hx - a.hx, ey = hy - a.hy;
+            if (rise > 0.0 && rise * rise >= slope * slope * (ex * ex + ey * ey) * (1.0 + 1e-9) + 1e-300) {
+              t_start[j] = a.rho * inv_h * (1.0 - 1e-10);
+              bounded = true;
+              break;
+            }
+          }
+        }
+        if (!bounded) t_start[j] = tile_clear_at(u);
+        current[u] = Column{-1.0, tan_e, hx, hy};
       }
-      double signal = 0.0;
-      const size_t i = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
-      if (hit) {
-        signal = scale * albedo * (options.ambient + std::max(0.0, normal.dot(scene.sun_direction)));
-        if (depth != nullptr) (*depth)[i] = static_cast<float>(t_best * ray_cam.z());
+      const Terrain::RayBatch batch{gox, goy, origin.z(), n, rays.gdx.data(), rays.gdy.data(), rays.dz.data(),
+                                    rays.inv_gdx.data(), rays.inv_gdy.data(), t_max.data(), t_start.data()};
+      terrain.TraceRays(batch, hits.data(), found);
+      for (int i = 0; i < n; ++i) {
+        const size_t j = static_cast<size_t>(i);
+        if (found[j]) {
+          seen[j] = Seen::kTerrain;
+          if (rays.inv_h[j] > 0.0) current[u0 + i].rho = hits[j].t * rays.horizontal[j];
+        } else if (seen[j] == Seen::kObject) {
+          hits[j].t = t_max[j];
+        }
       }
-      (*out)[i] = static_cast<float>(signal);
+      // Shading of the terrain hits: the hit triangle's unit normal against the sun (vectorized),
+      // and where the rays met the terrain (for the others the values go unused).
+      const double sx = sun.x(), sy = sun.y(), sz = sun.z(), ambient = options.ambient;
+      for (int i = 0; i < n; ++i) {
+        const size_t j = static_cast<size_t>(i);
+        const double nx = -hits[j].a * inv_res, ny = -hits[j].b * inv_res;
+        const double inv_norm = 1.0 / std::sqrt(nx * nx + ny * ny + 1.0);
+        shade[j] = ambient + std::max(0.0, (nx * inv_norm) * sx + (ny * inv_norm) * sy + inv_norm * sz);
+        hit_x[j] = origin.x() + hits[j].t * rays.dx[j];
+        hit_y[j] = origin.y() + hits[j].t * rays.dy[j];
+      }
+      terrain.Albedo(n, hit_x.data(), hit_y.data(), albedo.data());
+      for (int i = 0; i < n; ++i) {
+        const size_t j = static_cast<size_t>(i);
+        double signal = 0.0;
+        if (seen[j] == Seen::kTerrain) {
+          signal = scale * albedo[j] * shade[j];
+        } else if (seen[j] == Seen::kObject) {
+          signal = object_signal[j];
+        }
+        if (seen[j] != Seen::kSky && depth_row != nullptr) depth_row[u0 + i] = static_cast<float>(hits[j].t * rays.inv_len[j]);
+        out_row[u0 + i] = static_cast<float>(signal);
+      }
     }
   }
 }

@@ -123,11 +123,11 @@ void MissionSimulator::RenderStereo(size_t r, double t, uint64_t frame, std::vec
     const RenderScene scene = SceneAt(ti);
     const Eigen::Isometry3d T_world_body = robot.trajectory.Evaluate(ti).T_world_body;
     for (int c = 0; c < 2; ++c) {
+      // The first instant renders straight into the sum; later ones are added to it.
       CameraRenderer::RenderSignal(scene, cams[c]->intrinsics, T_world_body * cams[c]->T_body_cam,
-                                   mission_.render, &signal, c == 0 && i == samples / 2 ? left_depth : nullptr);
-      if (i == 0) {
-        sum[c] = signal;
-      } else {
+                                   mission_.render, i == 0 ? &sum[c] : &signal,
+                                   c == 0 && i == samples / 2 ? left_depth : nullptr);
+      if (i > 0) {
         for (size_t p = 0; p < signal.size(); ++p) sum[c][p] += signal[p];
       }
     }

@@ -4,7 +4,9 @@
 // detail at several scales, and a max-mipmap over the cell heights so that a ray finds its first
 // hit by skipping whole quadtree nodes it passes above.
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,29 +31,81 @@ class Terrain {
   Eigen::Vector3d Normal(double x, double y) const;
   // Albedo in [0, 1]: the stored texture plus a fine procedural layer for near-range detail.
   float Albedo(double x, double y) const;
-  // First hit of the ray origin + t * dir (dir unit length) with t in (0, t_max].
-  TerrainHit Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max) const;
+  // The same for many points at once.
+  void Albedo(int count, const double* x, const double* y, float* albedo) const;
+  // First hit of the ray origin + t * dir (dir unit length) with t in (0, t_max]. `t_start` is a
+  // distance the caller knows the ray to be clear up to (ClearDistance); the search starts there.
+  TerrainHit Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                     double t_start = 0.0) const;
+  // A distance up to which every ray origin + t * d with |d - dir| <= spread (d, dir unit length)
+  // is certainly clear of the terrain (t_max when it is clear all the way): a bound shared by a
+  // bundle of neighbouring pixel rays, found by one traversal of a dilated max-mipmap.
+  double ClearDistance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double spread,
+                       double t_max) const;
+
+  // Raycast in two steps, for renderers that prepare many rays at once (the preparation has the
+  // divisions and vectorizes; the trace is the scalar search). A ray in grid coordinates: x, y in
+  // cells from the grid's corner, z in metres; t stays the distance along the unit world ray.
+  struct GridRay {
+    double ox, oy, oz, dx, dy, dz, inv_dx, inv_dy;
+  };
+  GridRay ToGrid(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) const {
+    const double dx = dir.x() * inv_res_, dy = dir.y() * inv_res_;
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    return GridRay{(origin.x() + half_size_) * inv_res_, (origin.y() + half_size_) * inv_res_, origin.z(), dx, dy,
+                   dir.z(), dx != 0.0 ? 1.0 / dx : kInf, dy != 0.0 ? 1.0 / dy : kInf};
+  }
+  // A hit: its distance and the hit triangle's height steps per cell along x and y.
+  struct CellHit {
+    double t = 0.0, a = 0.0, b = 0.0;
+  };
+  bool Trace(const GridRay& ray, double t_max, double t_start, CellHit* hit) const;
+  // Trace for many rays from one origin (grid coordinates), as arrays: ray i searched over
+  // [t_start[i], t_max[i]]; found[i] tells whether hits[i] holds its hit.
+  struct RayBatch {
+    double ox, oy, oz;
+    int count;
+    const double *dx, *dy, *dz, *inv_dx, *inv_dy, *t_max, *t_start;
+  };
+  void TraceRays(const RayBatch& rays, CellHit* hits, bool* found) const;
+  // The unit normal of a hit triangle: (-a, -b, res) / |(-a, -b, res)|.
+  Eigen::Vector3d HitNormal(const CellHit& hit) const {
+    const double nx = -hit.a * inv_res_, ny = -hit.b * inv_res_;
+    const double inv_norm = 1.0 / std::sqrt(nx * nx + ny * ny + 1.0);
+    return Eigen::Vector3d(nx * inv_norm, ny * inv_norm, inv_norm);
+  }
+
   size_t memory_bytes() const;
   double max_height() const { return flat_mip_.back(); }
+  // An upper bound of the surface's slope: |Height(p) - Height(q)| <= max_slope() |p - q|.
+  double max_slope() const { return max_slope_; }
 
  private:
   float H(int ix, int iy) const { return h_[static_cast<size_t>(iy) * static_cast<size_t>(n_) + static_cast<size_t>(ix)]; }
   void BuildMaxMipmap();
+  float AlbedoAt(double x, double y) const;
+  bool TraceNear(const GridRay& ray, double t_max, double t_start, CellHit* hit) const;
+  bool TracePyramid(const GridRay& ray, double t_max, double t_from, CellHit* hit) const;
   void BuildAlbedo(const WorldOptions& options, const std::vector<Eigen::Vector4d>& rocks);
 
   double half_size_ = 0.0;
   double res_ = 0.1;
+  double inv_res_ = 10.0;
+  double max_slope_ = 0.0;
   int n_ = 0;       // vertices per side; cells per side is n_ - 1
   uint64_t seed_ = 0;
   std::vector<float> h_;
   std::vector<std::vector<float>> mip_;  // while building: level 0 per-cell maxima .. 1 x 1
   std::vector<int> mip_width_;
   std::vector<float> flat_mip_;        // all levels, level k at mip_offset_[k]
+  std::vector<float> dilated_mip_;     // same layout; level 0 is the maximum over 3 x 3 cells
   std::vector<size_t> mip_offset_;
   std::vector<float> grain_;           // 256 x 256 tile of fine albedo detail in [-1, 1]
   static constexpr int kStartLevel = 4;
+  static constexpr int kNearCells = 24;  // single-cell steps before a started ray uses the pyramid
   int tex_n_ = 0;
   double tex_res_ = 0.0;
+  double inv_tex_res_ = 0.0;
   std::vector<uint8_t> albedo_;
 };
 
