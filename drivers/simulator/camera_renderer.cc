@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "drivers/simulator/sim_random.h"
+#include "drivers/simulator/simd_clones.h"
 
 namespace cairn::sim {
 namespace {
@@ -74,17 +75,17 @@ float MarkerAlbedo(const SimMarker& m, double x, double y) {
 
 // One image row's rays, structure of arrays: the world direction, the camera ray's z (inverse
 // length of (x, y, 1)), the horizontal length and its inverse (0 for vertical rays), and the
-// horizontal components in grid cells with their inverses (used only where not zero).
+// horizontal components in terrain grid cells.
 struct RayRow {
-  std::vector<double> dx, dy, dz, inv_len, horizontal, inv_h, gdx, gdy, inv_gdx, inv_gdy;
+  std::vector<double> dx, dy, dz, inv_len, horizontal, inv_h, gdx, gdy;
 };
 
 // Straight-line arithmetic over plain arrays, so that the compiler vectorizes the square roots
 // and divisions (the pointers are parameters: restrict-qualified locals do not convince it).
-void SetUpRays(int w, const double* __restrict xs, double yy1, const double* r0, const double* base,
+CAIRN_SIM_CLONES void SetUpRays(int w, const double* __restrict xs, double yy1, const double* r0, const double* base,
                double inv_res, double* __restrict rdx, double* __restrict rdy, double* __restrict rdz,
                double* __restrict rlen, double* __restrict rhor, double* __restrict rih, double* __restrict rgx,
-               double* __restrict rgy, double* __restrict rigx, double* __restrict rigy) {
+               double* __restrict rgy) {
   const double ax = r0[0], ay = r0[1], az = r0[2], bx = base[0], by = base[1], bz = base[2];
   for (int u = 0; u < w; ++u) {
     const double xc = xs[u];
@@ -100,16 +101,56 @@ void SetUpRays(int w, const double* __restrict xs, double yy1, const double* r0,
     rih[u] = horizontal > 1e-9 ? inv_h : 0.0;
     rgx[u] = dx * inv_res;
     rgy[u] = dy * inv_res;
-    rigx[u] = 1.0 / (dx * inv_res);
-    rigy[u] = 1.0 / (dy * inv_res);
   }
 }
 
 void SetUpRays(int w, const double* xs, double yc, const Eigen::Vector3d& r0, const Eigen::Vector3d& row_base,
                double inv_res, RayRow* r) {
   SetUpRays(w, xs, yc * yc + 1.0, r0.data(), row_base.data(), inv_res, r->dx.data(), r->dy.data(), r->dz.data(),
-            r->inv_len.data(), r->horizontal.data(), r->inv_h.data(), r->gdx.data(), r->gdy.data(),
-            r->inv_gdx.data(), r->inv_gdy.data());
+            r->inv_len.data(), r->horizontal.data(), r->inv_h.data(), r->gdx.data(), r->gdy.data());
+}
+
+// The column bound from the pixel straight below, for a span of a row (straight-line code over
+// arrays, vectorized): where the image of the vertical runs within half a pixel of straight down
+// (|fx (nx - x nz)| < down_v / 2) and the lower ray met the terrain, the height gap between the
+// rays must outgrow what the steepest slope makes of the sideways gap (see RenderSignal). Also
+// stores this row's ray slopes and directions and clears its hits.
+CAIRN_SIM_CLONES void ColumnBound(int n, bool enabled, double slope2, double fx_nx, double fx_nz, double half_down_v,
+                 const double* __restrict xs, const double* __restrict dxs, const double* __restrict dys,
+                 const double* __restrict dzs, const double* __restrict inv_hs, const double* __restrict rho_a,
+                 const double* __restrict tan_a, const double* __restrict hx_a, const double* __restrict hy_a,
+                 double* __restrict tan_b, double* __restrict hx_b, double* __restrict hy_b,
+                 double* __restrict rho_b, double* __restrict t_start, double* __restrict bounded) {
+  for (int i = 0; i < n; ++i) {
+    const double inv_h = inv_hs[i];
+    const double tan_e = dzs[i] * inv_h, hx = dxs[i] * inv_h, hy = dys[i] * inv_h;
+    tan_b[i] = tan_e;
+    hx_b[i] = hx;
+    hy_b[i] = hy;
+    rho_b[i] = -1.0;
+    const double rise = tan_e - tan_a[i];
+    const double ex = hx - hx_a[i], ey = hy - hy_a[i];
+    const bool ok = enabled & (inv_h > 0.0) & (rho_a[i] > 0.0) & (std::abs(fx_nx - xs[i] * fx_nz) < half_down_v) &
+                    (rise > 0.0) & (rise * rise >= slope2 * (ex * ex + ey * ey) * (1.0 + 1e-9) + 1e-300);
+    t_start[i] = ok ? rho_a[i] * inv_h * (1.0 - 1e-10) : 0.0;
+    bounded[i] = ok ? 1.0 : 0.0;
+  }
+}
+
+// Shading of terrain hits, for a span of a row (vectorized): the hit triangle's unit normal
+// against the sun, and where the ray met the terrain (for rays that did not, the values go unused).
+CAIRN_SIM_CLONES void ShadeSpan(int n, const Terrain::CellHit* __restrict hits, double inv_res, const double* sun,
+                                double ambient, double ox, double oy, const double* __restrict dxs,
+                                const double* __restrict dys, double* __restrict shade, double* __restrict hit_x,
+                                double* __restrict hit_y) {
+  const double sx = sun[0], sy = sun[1], sz = sun[2];
+  for (int i = 0; i < n; ++i) {
+    const double nx = -hits[i].a * inv_res, ny = -hits[i].b * inv_res;
+    const double inv_norm = 1.0 / std::sqrt(nx * nx + ny * ny + 1.0);
+    shade[i] = ambient + std::max(0.0, (nx * inv_norm) * sx + (ny * inv_norm) * sy + inv_norm * sz);
+    hit_x[i] = ox + hits[i].t * dxs[i];
+    hit_y[i] = oy + hits[i].t * dys[i];
+  }
 }
 
 }  // namespace
@@ -134,7 +175,7 @@ void CameraRenderer::Render(const RenderScene& scene, const PinholeRadTan& k,
   ApplyNoise(signal, k.width, options, noise_seed, image);
 }
 
-void CameraRenderer::ApplyNoise(const std::vector<float>& signal, int width, const RenderOptions& options,
+CAIRN_SIM_CLONES void CameraRenderer::ApplyNoise(const std::vector<float>& signal, int width, const RenderOptions& options,
                                 uint64_t noise_seed, std::vector<uint8_t>* image) {
   const auto& gauss = GaussTable();
   image->resize(signal.size());
@@ -185,6 +226,9 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
                  const SimMarker* m, float albedo) {
     Object ob{T_world_obj.inverse(), half, marker, m, albedo};
     ob.o_local = ob.T_obj_world * origin;
+    // The pixel tests never hit a box from inside (a robot's camera within its own body) nor a
+    // marker from behind.
+    if (marker ? ob.o_local.z() <= 0.0 : (ob.o_local.cwiseAbs().array() <= half.array()).all()) return;
     const Eigen::Isometry3d T_cam_obj = T_cam_world * T_world_obj;
     const Eigen::Vector3d pad = half + Eigen::Vector3d::Constant(1e-3);
     std::array<Eigen::Vector3d, 8> c;
@@ -279,14 +323,20 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
   const double slope = terrain.max_slope();
   const bool origin_on_grid =
       std::abs(origin.x()) <= terrain.half_size() && std::abs(origin.y()) <= terrain.half_size();
-  struct Column {
-    double rho = -1.0;  // horizontal distance of the pixel's terrain hit; < 0: none
-    double tan_elevation = 0.0, hx = 0.0, hy = 0.0;
-  };
+  // Per pixel of the last kBelowRows + 1 rows (a ring): the horizontal distance of its terrain
+  // hit (< 0: none), the slope of its ray and the ray's unit horizontal direction.
   constexpr int kBelowRows = 4;
-  std::vector<Column> history(static_cast<size_t>(kBelowRows + 1) * static_cast<size_t>(w));
+  struct Columns {
+    double* rho;
+    double* tan_elevation;
+    double* hx;
+    double* hy;
+  };
+  std::vector<double> history(4 * static_cast<size_t>(kBelowRows + 1) * static_cast<size_t>(w), -1.0);
   auto history_row = [&](int row) {
-    return history.data() + static_cast<size_t>(row % (kBelowRows + 1)) * static_cast<size_t>(w);
+    double* base = history.data() + 4 * static_cast<size_t>(row % (kBelowRows + 1)) * static_cast<size_t>(w);
+    const size_t ws = static_cast<size_t>(w);
+    return Columns{base, base + ws, base + 2 * ws, base + 3 * ws};
   };
   // The nadir in camera coordinates: at pixel (u, v) the image of "down" points along
   // (fx (nx - x nz), fy (ny - y nz)) for the camera ray (x, y, 1).
@@ -298,13 +348,13 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
   constexpr int kSpan = 128;
   RayRow rays;
   for (auto* vec : {&rays.dx, &rays.dy, &rays.dz, &rays.inv_len, &rays.horizontal, &rays.inv_h, &rays.gdx,
-                    &rays.gdy, &rays.inv_gdx, &rays.inv_gdy}) {
+                    &rays.gdy}) {
     vec->resize(kSpan);
   }
   enum class Seen : uint8_t { kSky, kTerrain, kObject };
   std::array<Seen, kSpan> seen{};
   std::array<Terrain::CellHit, kSpan> hits{};
-  std::array<double, kSpan> object_signal{}, shade{}, t_max{}, t_start{}, hit_x{}, hit_y{};
+  std::array<double, kSpan> object_signal{}, shade{}, t_max{}, t_start{}, hit_x{}, hit_y{}, bounded{};
   std::array<float, kSpan> albedo{};
   bool found[kSpan] = {};
   std::vector<const Object*> row_objects;
@@ -317,10 +367,12 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
     }
     const double yc = row_y[static_cast<size_t>(v)];
     const Eigen::Vector3d row_base = r1 * yc + r2;
-    Column* current = history_row(v);
-    const Column* below_rows[kBelowRows + 1] = {nullptr};
+    const Columns current = history_row(v);
+    // (Ring rows past the bottom of the image hold no hits.)
+    Columns below_rows[kBelowRows + 1] = {};
+    for (int m = 1; m <= kBelowRows; ++m) below_rows[m] = history_row(v + m);
     const int rows_below = std::min(kBelowRows, h - 1 - v);
-    for (int m = 1; m <= rows_below; ++m) below_rows[m] = history_row(v + m);
+    const bool column_bound = rows_below > 0 && origin_on_grid;
     row_objects.clear();
     for (const Object& ob : objects) {
       if (v >= ob.v0 && v <= ob.v1) row_objects.push_back(&ob);
@@ -331,16 +383,19 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
     for (int u0 = 0; u0 < w; u0 += kSpan) {
       const int n = std::min(kSpan, w - u0);
       SetUpRays(n, col_x.data() + u0, yc, r0, row_base, inv_res, &rays);
-      // Objects first (they bound the terrain search), then where the terrain search starts.
-      for (int i = 0; i < n; ++i) {
-        const int u = u0 + i;
-        const size_t j = static_cast<size_t>(i);
-        const Eigen::Vector3d dir(rays.dx[j], rays.dy[j], rays.dz[j]);
-        double t_best = options.max_range;
-        seen[j] = Seen::kSky;
-        if (!row_objects.empty()) {
+      // Objects first: they bound the terrain search.
+      if (row_objects.empty()) {
+        std::fill_n(seen.begin(), n, Seen::kSky);
+        std::fill_n(t_max.begin(), n, options.max_range);
+      } else {
+        for (int i = 0; i < n; ++i) {
+          const int u = u0 + i;
+          const size_t j = static_cast<size_t>(i);
+          const Eigen::Vector3d dir(rays.dx[j], rays.dy[j], rays.dz[j]);
+          double t_best = options.max_range;
           double object_albedo = 0.0;
           Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+          seen[j] = Seen::kSky;
           for (const Object* obp : row_objects) {
             const Object& ob = *obp;
             if (u < ob.u0 || u > ob.u1) continue;
@@ -368,54 +423,56 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
           if (seen[j] == Seen::kObject) {
             object_signal[j] = scale * object_albedo * (options.ambient + std::max(0.0, normal.dot(sun)));
           }
+          t_max[j] = t_best;
         }
-        t_max[j] = t_best;
+      }
+      // Then where the terrain search starts: the column bound from the pixel straight below where
+      // that is the one (vectorized), else from one further down along the image of the vertical,
+      // else the tile's clear distance.
+      ColumnBound(n, column_bound && down_v > 0.0, slope * slope, k.fx * nadir.x(), k.fx * nadir.z(), 0.5 * down_v,
+                  col_x.data() + u0, rays.dx.data(), rays.dy.data(), rays.dz.data(), rays.inv_h.data(),
+                  below_rows[1].rho + u0, below_rows[1].tan_elevation + u0, below_rows[1].hx + u0,
+                  below_rows[1].hy + u0, current.tan_elevation + u0, current.hx + u0, current.hy + u0,
+                  current.rho + u0, t_start.data(), bounded.data());
+      for (int i = 0; i < n; ++i) {
+        const size_t j = static_cast<size_t>(i);
+        if (bounded[j] != 0.0) continue;
+        const int u = u0 + i;
         const double inv_h = rays.inv_h[j];
-        const double tan_e = dir.z() * inv_h, hx = dir.x() * inv_h, hy = dir.y() * inv_h;
-        bool bounded = false;
-        if (down_v > 0.0 && inv_h > 0.0 && origin_on_grid) {
+        const double tan_e = current.tan_elevation[u], hx = current.hx[u], hy = current.hy[u];
+        bool found_bound = false;
+        if (column_bound && down_v > 0.0 && inv_h > 0.0) {
           const double down_u = k.fx * (nadir.x() - col_x[static_cast<size_t>(u)] * nadir.z());
-          for (int m = 1; m <= rows_below; ++m) {
+          for (int m = 1; m <= rows_below && !found_bound; ++m) {
             const double shift = m * down_u;  // columns to the pixel m rows down, times down_v
             const int ua = 2.0 * std::abs(shift) < down_v ? u : u + static_cast<int>(std::lround(shift / down_v));
             if (ua < 0 || ua >= w) break;
-            const Column& a = below_rows[m][ua];
-            if (!(a.rho > 0.0)) continue;
-            const double rise = tan_e - a.tan_elevation;
-            const double ex = hx - a.hx, ey = hy - a.hy;
+            const Columns& a = below_rows[m];
+            if (!(a.rho[ua] > 0.0)) continue;
+            const double rise = tan_e - a.tan_elevation[ua];
+            const double ex = hx - a.hx[ua], ey = hy - a.hy[ua];
             if (rise > 0.0 && rise * rise >= slope * slope * (ex * ex + ey * ey) * (1.0 + 1e-9) + 1e-300) {
-              t_start[j] = a.rho * inv_h * (1.0 - 1e-10);
-              bounded = true;
-              break;
+              t_start[j] = a.rho[ua] * inv_h * (1.0 - 1e-10);
+              found_bound = true;
             }
           }
         }
-        if (!bounded) t_start[j] = tile_clear_at(u);
-        current[u] = Column{-1.0, tan_e, hx, hy};
+        if (!found_bound) t_start[j] = tile_clear_at(u);
       }
       const Terrain::RayBatch batch{gox, goy, origin.z(), n, rays.gdx.data(), rays.gdy.data(), rays.dz.data(),
-                                    rays.inv_gdx.data(), rays.inv_gdy.data(), t_max.data(), t_start.data()};
+                                    t_max.data(), t_start.data()};
       terrain.TraceRays(batch, hits.data(), found);
       for (int i = 0; i < n; ++i) {
         const size_t j = static_cast<size_t>(i);
         if (found[j]) {
           seen[j] = Seen::kTerrain;
-          if (rays.inv_h[j] > 0.0) current[u0 + i].rho = hits[j].t * rays.horizontal[j];
+          if (rays.inv_h[j] > 0.0) current.rho[u0 + i] = hits[j].t * rays.horizontal[j];
         } else if (seen[j] == Seen::kObject) {
           hits[j].t = t_max[j];
         }
       }
-      // Shading of the terrain hits: the hit triangle's unit normal against the sun (vectorized),
-      // and where the rays met the terrain (for the others the values go unused).
-      const double sx = sun.x(), sy = sun.y(), sz = sun.z(), ambient = options.ambient;
-      for (int i = 0; i < n; ++i) {
-        const size_t j = static_cast<size_t>(i);
-        const double nx = -hits[j].a * inv_res, ny = -hits[j].b * inv_res;
-        const double inv_norm = 1.0 / std::sqrt(nx * nx + ny * ny + 1.0);
-        shade[j] = ambient + std::max(0.0, (nx * inv_norm) * sx + (ny * inv_norm) * sy + inv_norm * sz);
-        hit_x[j] = origin.x() + hits[j].t * rays.dx[j];
-        hit_y[j] = origin.y() + hits[j].t * rays.dy[j];
-      }
+      ShadeSpan(n, hits.data(), inv_res, sun.data(), options.ambient, origin.x(), origin.y(), rays.dx.data(),
+                rays.dy.data(), shade.data(), hit_x.data(), hit_y.data());
       terrain.Albedo(n, hit_x.data(), hit_y.data(), albedo.data());
       for (int i = 0; i < n; ++i) {
         const size_t j = static_cast<size_t>(i);

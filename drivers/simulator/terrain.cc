@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "drivers/simulator/sim_random.h"
+#include "drivers/simulator/simd_clones.h"
 
 namespace cairn::sim {
 namespace {
@@ -277,7 +278,7 @@ float Terrain::Albedo(double x, double y) const { return AlbedoAt(x, y); }
 
 // The same arithmetic as AlbedoAt, in three passes over a batch: texture coordinates
 // (vectorized), the eight texel loads, and the two bilinear interpolations (vectorized).
-void Terrain::Albedo(int count, const double* x, const double* y, float* albedo) const {
+CAIRN_SIM_CLONES void Terrain::Albedo(int count, const double* x, const double* y, float* albedo) const {
   constexpr int kBatch = 128;
   const double tex_max = tex_n_ - 1.000001;
   const int64_t stride = tex_n_;
@@ -434,11 +435,98 @@ bool Terrain::Trace(const GridRay& r, double t_max, double t_start, CellHit* hit
   return TraceNear(r, t_max, t_start, hit);
 }
 
-void Terrain::TraceRays(const RayBatch& rays, CellHit* hits, bool* found) const {
-  for (int i = 0; i < rays.count; ++i) {
-    const size_t j = static_cast<size_t>(i);
-    const GridRay r{rays.ox, rays.oy, rays.oz, rays.dx[j], rays.dy[j], rays.dz[j], rays.inv_dx[j], rays.inv_dy[j]};
-    found[j] = TraceNear(r, rays.t_max[j], rays.t_start[j], &hits[j]);
+namespace {
+
+constexpr int kRayBatch = 128;
+
+// The start cell of each ray, where the start is inside the grid (straight-line code over arrays,
+// vectorized); elsewhere the search interval is empty (lo = infinity).
+void StartCells(int count, double ox, double oy, double oz, double top_height, int cells, int stride,
+                const double* __restrict dxs, const double* __restrict dys, const double* __restrict dzs,
+                const double* __restrict t_max, const double* __restrict t_start, int* __restrict cell,
+                double* __restrict lo, double* __restrict hi, double* __restrict lx, double* __restrict ly) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const bool above_all = oz > top_height;
+  for (int i = 0; i < count; ++i) {
+    const double t = t_start[i];
+    const double sx = ox + t * dxs[i], sy = oy + t * dys[i];
+    const bool ok = (t > 0.0) & (sx >= 0.0) & (sy >= 0.0) & (sx < cells) & (sy < cells) & (t < t_max[i]) &
+                    !((dzs[i] >= 0.0) & above_all);
+    const int ix = static_cast<int>(ok ? sx : 0.0), iy = static_cast<int>(ok ? sy : 0.0);
+    cell[i] = iy * stride + ix;
+    lx[i] = ox - ix;
+    ly[i] = oy - iy;
+    lo[i] = ok ? t - 1e-9 : kInf;
+    hi[i] = t_max[i] + 1e-9;
+  }
+}
+
+// HitCell's arithmetic for every ray's start cell, lane by lane (vectorized). The search runs from
+// the start to t_max, the hit confined to the cell's square: the ray's stretch over the cell.
+void HitStartCells(int count, double oz, const double* __restrict dxs, const double* __restrict dys,
+                   const double* __restrict dzs, const double* __restrict h00, const double* __restrict h10,
+                   const double* __restrict h01, const double* __restrict h11, const double* __restrict lo,
+                   const double* __restrict hi, const double* __restrict lx, const double* __restrict ly,
+                   double* __restrict hit, double* __restrict th_best, double* __restrict a_best,
+                   double* __restrict b_best) {
+  constexpr double kTol = 1e-7;
+  for (int i = 0; i < count; ++i) {
+    const double dx = dxs[i], dy = dys[i], dz = dzs[i];
+    const double a0 = h10[i] - h00[i], b0 = h11[i] - h10[i], a1 = h11[i] - h01[i], b1 = h01[i] - h00[i];
+    const double th0 = (oz - (h00[i] + a0 * lx[i] + b0 * ly[i])) / -(dz - a0 * dx - b0 * dy);
+    const double th1 = (oz - (h00[i] + a1 * lx[i] + b1 * ly[i])) / -(dz - a1 * dx - b1 * dy);
+    const double u0 = lx[i] + th0 * dx, v0 = ly[i] + th0 * dy, u1 = lx[i] + th1 * dx, v1 = ly[i] + th1 * dy;
+    const bool ok0 = (th0 >= lo[i]) & (th0 <= hi[i]) & (th0 > 0.0) & (u0 >= -kTol) & (u0 <= 1 + kTol) &
+                     (v0 >= -kTol) & (v0 <= 1 + kTol) & (u0 - v0 >= -kTol);
+    const bool ok1 = (th1 >= lo[i]) & (th1 <= hi[i]) & (th1 > 0.0) & (u1 >= -kTol) & (u1 <= 1 + kTol) &
+                     (v1 >= -kTol) & (v1 <= 1 + kTol) & (v1 - u1 >= -kTol);
+    const bool pick1 = ok1 & (!ok0 | (th1 < th0));
+    hit[i] = ok0 | ok1 ? 1.0 : 0.0;
+    th_best[i] = pick1 ? th1 : th0;
+    a_best[i] = pick1 ? a1 : a0;
+    b_best[i] = pick1 ? b1 : b0;
+  }
+}
+
+}  // namespace
+
+// Most rays of a batch, started close to the surface, meet it in the cell where they start. That
+// cell is searched for all of them at once, in passes that vectorize around one that loads the
+// heights (the same arithmetic as HitCell, lane by lane); the rays that miss it walk on one at a
+// time.
+CAIRN_SIM_CLONES void Terrain::TraceRays(const RayBatch& rays, CellHit* hits, bool* found) const {
+  const size_t n = static_cast<size_t>(n_);
+  const double oz = rays.oz;
+  for (int b0 = 0; b0 < rays.count; b0 += kRayBatch) {
+    const int count = std::min(kRayBatch, rays.count - b0);
+    int cell[kRayBatch];
+    double lo[kRayBatch], hi[kRayBatch], lx[kRayBatch], ly[kRayBatch];
+    StartCells(count, rays.ox, rays.oy, oz, flat_mip_.back(), n_ - 1, n_, rays.dx + b0, rays.dy + b0, rays.dz + b0,
+               rays.t_max + b0, rays.t_start + b0, cell, lo, hi, lx, ly);
+    double h00[kRayBatch], h10[kRayBatch], h01[kRayBatch], h11[kRayBatch];
+    const float* heights = h_.data();
+    for (int i = 0; i < count; ++i) {
+      const float* p = heights + cell[i];
+      h00[i] = p[0];
+      h10[i] = p[1];
+      h01[i] = p[n];
+      h11[i] = p[n + 1];
+    }
+    double hit[kRayBatch], th[kRayBatch], a[kRayBatch], b[kRayBatch];
+    HitStartCells(count, oz, rays.dx + b0, rays.dy + b0, rays.dz + b0, h00, h10, h01, h11, lo, hi, lx, ly, hit, th,
+                  a, b);
+    for (int i = 0; i < count; ++i) {
+      const size_t j = static_cast<size_t>(b0 + i);
+      if (hit[i] != 0.0) {
+        hits[j] = CellHit{th[i], a[i], b[i]};
+        found[j] = true;
+      } else {
+        constexpr double kInf = std::numeric_limits<double>::infinity();
+        const double dx = rays.dx[j], dy = rays.dy[j];
+        const GridRay r{rays.ox, rays.oy, oz, dx, dy, rays.dz[j], dx != 0.0 ? 1.0 / dx : kInf, dy != 0.0 ? 1.0 / dy : kInf};
+        found[j] = TraceNear(r, rays.t_max[j], rays.t_start[j], &hits[j]);
+      }
+    }
   }
 }
 

@@ -65,7 +65,7 @@ class Terrain {
   struct RayBatch {
     double ox, oy, oz;
     int count;
-    const double *dx, *dy, *dz, *inv_dx, *inv_dy, *t_max, *t_start;
+    const double *dx, *dy, *dz, *t_max, *t_start;
   };
   void TraceRays(const RayBatch& rays, CellHit* hits, bool* found) const;
   // The unit normal of a hit triangle: (-a, -b, res) / |(-a, -b, res)|.
