@@ -19,29 +19,84 @@ inline double LatticeValue(uint64_t seed, int64_t ix, int64_t iy, uint64_t layer
   return static_cast<double>(h >> 11) * 0x1.0p-52 - 1.0;
 }
 
-// Value noise with quintic fade (C2), wavelength 1 in lattice units.
-double ValueNoise(uint64_t seed, double x, double y, uint64_t layer) {
-  const double fx = std::floor(x), fy = std::floor(y);
-  const int64_t ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy);
-  const double u = x - fx, v = y - fy;
-  const double su = u * u * u * (u * (u * 6 - 15) + 10), sv = v * v * v * (v * (v * 6 - 15) + 10);
-  const double a = LatticeValue(seed, ix, iy, layer), b = LatticeValue(seed, ix + 1, iy, layer);
-  const double c = LatticeValue(seed, ix, iy + 1, layer), d = LatticeValue(seed, ix + 1, iy + 1, layer);
-  return (a + (b - a) * su) * (1 - sv) + (c + (d - c) * su) * sv;
-}
-
-// Fractal sum of value noise from `wavelength` down by halves, amplitudes falling with `gain`.
-double Fbm(uint64_t seed, double x, double y, double wavelength, int octaves, double gain,
-           uint64_t layer) {
-  double sum = 0.0, amp = 1.0, norm = 0.0;
-  for (int k = 0; k < octaves; ++k) {
-    sum += amp * ValueNoise(seed, x / wavelength, y / wavelength, layer * 64 + static_cast<uint64_t>(k));
-    norm += amp;
-    amp *= gain;
-    wavelength *= 0.5;
+// Fractal sum of value noise (quintic fade, wavelength 1 in lattice units) from `wavelength` down by
+// halves, amplitudes falling with `gain`, sampled on a grid (x = i * step - half for column i, y
+// likewise for row j), one row at a time with the rows in increasing order. Every octave's lattice
+// values are computed once per lattice point: each octave caches the two lattice rows around the
+// current grid row.
+class FbmRows {
+ public:
+  FbmRows(uint64_t seed, int count, double step, double half, double wavelength, int octaves, double gain,
+          uint64_t layer)
+      : seed_(seed), count_(count), step_(step), half_(half) {
+    double amp = 1.0;
+    for (int k = 0; k < octaves; ++k) {
+      Octave o;
+      o.wavelength = wavelength;
+      o.amp = amp;
+      o.layer = layer * 64 + static_cast<uint64_t>(k);
+      // Per column: the lattice column left of the sample and the fade weight towards the right.
+      o.column.resize(static_cast<size_t>(count));
+      o.fade.resize(static_cast<size_t>(count));
+      for (int i = 0; i < count; ++i) {
+        const double x = (i * step - half) / wavelength;
+        const double fx = std::floor(x);
+        const double u = x - fx;
+        o.column[static_cast<size_t>(i)] = static_cast<int64_t>(fx);
+        o.fade[static_cast<size_t>(i)] = u * u * u * (u * (u * 6 - 15) + 10);
+      }
+      o.first_column = o.column.front();
+      const size_t span = static_cast<size_t>(o.column.back() - o.first_column + 2);
+      o.row0.resize(span);
+      o.row1.resize(span);
+      norm_ += amp;
+      amp *= gain;
+      wavelength *= 0.5;
+      octaves_.push_back(std::move(o));
+    }
   }
-  return sum / norm;
-}
+
+  void Row(int j, double* out) {
+    std::fill(out, out + count_, 0.0);
+    for (Octave& o : octaves_) {
+      const double y = (j * step_ - half_) / o.wavelength;
+      const double fy = std::floor(y);
+      const int64_t iy = static_cast<int64_t>(fy);
+      const double v = y - fy;
+      const double sv = v * v * v * (v * (v * 6 - 15) + 10);
+      if (iy != o.cached_row) {
+        for (size_t c = 0; c < o.row0.size(); ++c) {
+          const int64_t ix = o.first_column + static_cast<int64_t>(c);
+          o.row0[c] = LatticeValue(seed_, ix, iy, o.layer);
+          o.row1[c] = LatticeValue(seed_, ix, iy + 1, o.layer);
+        }
+        o.cached_row = iy;
+      }
+      for (int i = 0; i < count_; ++i) {
+        const size_t c = static_cast<size_t>(o.column[static_cast<size_t>(i)] - o.first_column);
+        const double su = o.fade[static_cast<size_t>(i)];
+        const double a = o.row0[c], b = o.row0[c + 1], cc = o.row1[c], d = o.row1[c + 1];
+        out[i] += o.amp * ((a + (b - a) * su) * (1 - sv) + (cc + (d - cc) * su) * sv);
+      }
+    }
+    for (int i = 0; i < count_; ++i) out[i] /= norm_;
+  }
+
+ private:
+  struct Octave {
+    double wavelength = 0.0, amp = 0.0;
+    uint64_t layer = 0;
+    std::vector<int64_t> column;
+    std::vector<double> fade;
+    int64_t first_column = 0;
+    int64_t cached_row = std::numeric_limits<int64_t>::min();
+    std::vector<double> row0, row1;
+  };
+  uint64_t seed_;
+  int count_;
+  double step_, half_, norm_ = 0.0;
+  std::vector<Octave> octaves_;
+};
 
 // Adds `profile(distance / radius)` to every vertex within `reach * radius` of (cx, cy).
 template <class Profile>
@@ -75,11 +130,15 @@ Terrain Terrain::Generate(const WorldOptions& o) {
   t.h_.assign(static_cast<size_t>(n) * static_cast<size_t>(n), 0.0f);
 
   // Rolling ground: wavelengths from 24 m down to ~0.4 m.
-  for (int iy = 0; iy < n; ++iy) {
-    for (int ix = 0; ix < n; ++ix) {
-      const double x = ix * res - half, y = iy * res - half;
-      t.h_[static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix)] =
-          static_cast<float>(o.relief * Fbm(t.seed_, x, y, 24.0, 7, 0.45, 1));
+  {
+    FbmRows ground(t.seed_, n, res, half, 24.0, 7, 0.45, 1);
+    std::vector<double> row(static_cast<size_t>(n));
+    for (int iy = 0; iy < n; ++iy) {
+      ground.Row(iy, row.data());
+      for (int ix = 0; ix < n; ++ix) {
+        t.h_[static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix)] =
+            static_cast<float>(o.relief * row[static_cast<size_t>(ix)]);
+      }
     }
   }
   SimRandom rng = SimRandom::Stream(t.seed_, 17);
@@ -196,14 +255,17 @@ void Terrain::BuildAlbedo(const WorldOptions& o, const std::vector<Eigen::Vector
   inv_tex_res_ = 1.0 / tex_res_;
   tex_n_ = static_cast<int>(std::lround(2 * half_size_ / tex_res_)) + 1;
   std::vector<float> a(static_cast<size_t>(tex_n_) * static_cast<size_t>(tex_n_));
+  // Large patches (regolith colour) and fine grains, with most energy at stereo-relevant scales.
+  FbmRows coarse_rows(seed_, tex_n_, tex_res_, half_size_, 8.0, 4, 0.6, 2);
+  FbmRows fine_rows(seed_, tex_n_, tex_res_, half_size_, 0.4, 4, 0.7, 3);
+  std::vector<double> coarse(static_cast<size_t>(tex_n_)), fine(static_cast<size_t>(tex_n_));
   for (int iy = 0; iy < tex_n_; ++iy) {
+    coarse_rows.Row(iy, coarse.data());
+    fine_rows.Row(iy, fine.data());
     for (int ix = 0; ix < tex_n_; ++ix) {
-      const double x = ix * tex_res_ - half_size_, y = iy * tex_res_ - half_size_;
-      // Large patches (regolith colour) and fine grains, with most energy at stereo-relevant scales.
-      const double coarse = Fbm(seed_, x, y, 8.0, 4, 0.6, 2);
-      const double fine = Fbm(seed_, x, y, 0.4, 4, 0.7, 3);
-      a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n_) + static_cast<size_t>(ix)] =
-          static_cast<float>(0.5 + o.albedo_contrast * (0.5 * coarse + 0.9 * fine));
+      const size_t i = static_cast<size_t>(ix);
+      a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n_) + i] =
+          static_cast<float>(0.5 + o.albedo_contrast * (0.5 * coarse[i] + 0.9 * fine[i]));
     }
   }
   // Rocks are darker than the regolith around them.
