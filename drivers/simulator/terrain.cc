@@ -503,7 +503,7 @@ constexpr int kRayBatch = 128;
 
 // The start cell of each ray, where the start is inside the grid (straight-line code over arrays,
 // vectorized); elsewhere the search interval is empty (lo = infinity).
-void StartCells(int count, double ox, double oy, double oz, double top_height, int cells, int stride,
+CAIRN_SIM_CLONES void StartCells(int count, double ox, double oy, double oz, double top_height, int cells, int stride,
                 const double* __restrict dxs, const double* __restrict dys, const double* __restrict dzs,
                 const double* __restrict t_max, const double* __restrict t_start, int* __restrict cell,
                 double* __restrict lo, double* __restrict hi, double* __restrict lx, double* __restrict ly) {
@@ -525,7 +525,7 @@ void StartCells(int count, double ox, double oy, double oz, double top_height, i
 
 // HitCell's arithmetic for every ray's start cell, lane by lane (vectorized). The search runs from
 // the start to t_max, the hit confined to the cell's square: the ray's stretch over the cell.
-void HitStartCells(int count, double oz, const double* __restrict dxs, const double* __restrict dys,
+CAIRN_SIM_CLONES void HitStartCells(int count, double oz, const double* __restrict dxs, const double* __restrict dys,
                    const double* __restrict dzs, const double* __restrict h00, const double* __restrict h10,
                    const double* __restrict h01, const double* __restrict h11, const double* __restrict lo,
                    const double* __restrict hi, const double* __restrict lx, const double* __restrict ly,
