@@ -16,6 +16,7 @@ struct SimSourceOptions {
   double duration = 60.0;                // s; the source ends (end of data) after it
   double image_scale = 1.0;              // < 1 shrinks every camera
   int64_t motion_blur_samples = 1;       // > 1 averages instants over the exposure
+  int64_t render_threads = 2;            // 2: the right camera renders on a second thread
 
   void Visit(OptionsVisitor& v) {
     v.Text("world", world);
@@ -24,6 +25,7 @@ struct SimSourceOptions {
     v.Number("duration", duration, 0.1, 86400.0, "s");
     v.Number("image_scale", image_scale, 0.05, 1.0, "");
     v.Integer("motion_blur_samples", motion_blur_samples, 1, 64, "");
+    v.Integer("render_threads", render_threads, 1, 2, "");
   }
 };
 

@@ -38,6 +38,7 @@ Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const 
   mission.duration = o.duration;
   mission.image_scale = o.image_scale;
   mission.motion_blur_samples = static_cast<int>(o.motion_blur_samples);
+  mission.render_threads = static_cast<int>(o.render_threads);
   // The simulated platform controller speaks the layout this robot's decoder expects.
   mission.can = options.can;
   const auto it = std::find(mission.robots.begin(), mission.robots.end(), options.robot.name);

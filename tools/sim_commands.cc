@@ -150,6 +150,7 @@ int RunSim(const CommandArgs& args) {
     return 1;
   }
   mission.can = *can;
+  mission.render_threads = 2;  // the right camera on a second thread: the same bytes, sooner
   const auto t0 = std::chrono::steady_clock::now();
   auto simulator = sim::MissionSimulator::Create(world, mission);
   if (!simulator.ok()) {

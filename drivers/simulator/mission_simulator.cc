@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
+#include <thread>
 
 #include "drivers/simulator/candump_format.h"
 #include "drivers/simulator/euroc_writer.h"
@@ -50,6 +51,9 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
   if (mission.robots.size() > 20) return InvalidArgumentError("--robots: at most 20 robots per mission");
   if (mission.motion_blur_samples < 1 || mission.motion_blur_samples > 64) {
     return InvalidArgumentError("--motion-blur: samples per exposure must be in [1, 64]");
+  }
+  if (mission.render_threads < 1 || mission.render_threads > 2) {
+    return InvalidArgumentError("render threads per stereo pair must be 1 or 2");
   }
   if (!(mission.duration > 0.0) || mission.duration > 3600.0) {
     return InvalidArgumentError("--duration: must be in (0, 3600] s");
@@ -116,29 +120,35 @@ void MissionSimulator::RenderStereo(size_t r, double t, uint64_t frame, std::vec
   const int samples = std::max(1, mission_.motion_blur_samples);
   const CameraCalibration* cams[2] = {&robot.stereo.left, &robot.stereo.right};
   std::vector<uint8_t>* images[2] = {left, right};
-  std::vector<float> sum[2], signal;
-  for (int i = 0; i < samples; ++i) {
-    // Instants spread evenly over the exposure, centred on the frame time (mid-exposure).
-    const double ti = samples == 1 ? t : t + mission_.exposure_time * ((i + 0.5) / samples - 0.5);
-    const RenderScene scene = SceneAt(ti);
-    const Eigen::Isometry3d T_world_body = robot.trajectory.Evaluate(ti).T_world_body;
-    for (int c = 0; c < 2; ++c) {
+  // One camera's image: its noise-free signal averaged over the exposure, then the sensor noise.
+  auto render_camera = [&](int c) {
+    std::vector<float> sum, signal;
+    for (int i = 0; i < samples; ++i) {
+      // Instants spread evenly over the exposure, centred on the frame time (mid-exposure).
+      const double ti = samples == 1 ? t : t + mission_.exposure_time * ((i + 0.5) / samples - 0.5);
+      const RenderScene scene = SceneAt(ti);
+      const Eigen::Isometry3d T_world_body = robot.trajectory.Evaluate(ti).T_world_body;
       // The first instant renders straight into the sum; later ones are added to it.
-      CameraRenderer::RenderSignal(scene, cams[c]->intrinsics, T_world_body * cams[c]->T_body_cam,
-                                   mission_.render, i == 0 ? &sum[c] : &signal,
-                                   c == 0 && i == samples / 2 ? left_depth : nullptr);
+      CameraRenderer::RenderSignal(scene, cams[c]->intrinsics, T_world_body * cams[c]->T_body_cam, mission_.render,
+                                   i == 0 ? &sum : &signal, c == 0 && i == samples / 2 ? left_depth : nullptr);
       if (i > 0) {
-        for (size_t p = 0; p < signal.size(); ++p) sum[c][p] += signal[p];
+        for (size_t p = 0; p < signal.size(); ++p) sum[p] += signal[p];
       }
     }
-  }
-  for (int c = 0; c < 2; ++c) {
     if (samples > 1) {
-      for (float& v : sum[c]) v /= static_cast<float>(samples);
+      for (float& v : sum) v /= static_cast<float>(samples);
     }
-    CameraRenderer::ApplyNoise(sum[c], cams[c]->intrinsics.width, mission_.render,
+    CameraRenderer::ApplyNoise(sum, cams[c]->intrinsics.width, mission_.render,
                                SimRandom::Mix(seed ^ SimRandom::Mix(r * 1000003 + frame * 2 + static_cast<uint64_t>(c))),
                                images[c]);
+  };
+  if (mission_.render_threads > 1) {
+    std::thread right_camera(render_camera, 1);
+    render_camera(0);
+    right_camera.join();
+  } else {
+    render_camera(0);
+    render_camera(1);
   }
 }
 

@@ -32,6 +32,9 @@ struct MissionOptions {
   double exposure_time = 0.004;   // s, reported with every stereo frame
   // > 1: each image averages this many instants spread over the exposure (motion blur).
   int motion_blur_samples = 1;
+  // 2: RenderStereo renders the right camera on a thread of its own. Each image is computed by one
+  // thread either way, so the bytes do not depend on this.
+  int render_threads = 1;
   Timestamp start = Timestamp::FromNanoseconds(int64_t{1700000000} * 1000000000);
   RenderOptions render;
   CanWheelOptions can;            // frame layout of the rovers' platform controllers
@@ -59,7 +62,7 @@ class MissionSimulator {
   std::vector<ImuTruth> ImuStream(size_t r) const;
   WheelCanStream WheelStream(size_t r) const;
 
-  // Renders both images of robot `r` at mission time t.
+  // Renders both images of robot `r` at mission time t (thread-safe: the simulator is not changed).
   void RenderStereo(size_t r, double t, uint64_t frame, std::vector<uint8_t>* left,
                     std::vector<uint8_t>* right, std::vector<float>* left_depth = nullptr) const;
 

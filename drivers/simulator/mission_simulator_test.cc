@@ -135,6 +135,30 @@ TEST(MissionSimulatorTest, MotionBlurSmoothsTheImage) {
   EXPECT_LT(energy(b), 0.97 * energy(a));
 }
 
+// Each image is computed by one thread, so a second render thread changes no byte (also with
+// motion blur, and for the depth of the left image).
+TEST(MissionSimulatorTest, RenderThreadsDoNotChangeTheImages) {
+  MissionOptions m = ShortMission();
+  m.image_scale = 0.25;
+  m.motion_blur_samples = 3;
+  auto one = MissionSimulator::Create(SmallWorld(3), m);
+  m.render_threads = 2;
+  auto two = MissionSimulator::Create(SmallWorld(3), m);
+  ASSERT_TRUE(one.ok() && two.ok());
+  for (size_t r = 0; r < 2; ++r) {
+    std::vector<uint8_t> left1, right1, left2, right2;
+    std::vector<float> depth1, depth2;
+    (*one)->RenderStereo(r, 0.4, 4, &left1, &right1, &depth1);
+    (*two)->RenderStereo(r, 0.4, 4, &left2, &right2, &depth2);
+    EXPECT_EQ(left1, left2);
+    EXPECT_EQ(right1, right2);
+    EXPECT_EQ(depth1, depth2);
+    EXPECT_NE(left1, right1);
+  }
+  m.render_threads = 3;
+  EXPECT_FALSE(MissionSimulator::Create(SmallWorld(3), m).ok());
+}
+
 TEST(MissionSimulatorTest, RejectsUnknownAndDuplicateRobots) {
   MissionOptions m = ShortMission();
   m.robots = {"rover", "submarine"};
