@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <memory>
 
 #include "drivers/simulator/sim_random.h"
 #include "drivers/simulator/simd_clones.h"
@@ -82,10 +81,11 @@ struct RayRow {
 
 // Straight-line arithmetic over plain arrays, so that the compiler vectorizes the square roots
 // and divisions (the pointers are parameters: restrict-qualified locals do not convince it).
-CAIRN_SIM_CLONES void SetUpRays(int w, const double* __restrict xs, double yy1, const double* r0, const double* base,
-               double inv_res, double* __restrict rdx, double* __restrict rdy, double* __restrict rdz,
-               double* __restrict rlen, double* __restrict rhor, double* __restrict rih, double* __restrict rgx,
-               double* __restrict rgy) {
+CAIRN_SIM_CLONES void SetUpRays(int w, const double* __restrict xs, double yy1, const double* r0,
+                                const double* base, double inv_res, double* __restrict rdx,
+                                double* __restrict rdy, double* __restrict rdz, double* __restrict rlen,
+                                double* __restrict rhor, double* __restrict rih, double* __restrict rgx,
+                                double* __restrict rgy) {
   const double ax = r0[0], ay = r0[1], az = r0[2], bx = base[0], by = base[1], bz = base[2];
   for (int u = 0; u < w; ++u) {
     const double xc = xs[u];
@@ -114,13 +114,15 @@ void SetUpRays(int w, const double* xs, double yc, const Eigen::Vector3d& r0, co
 // arrays, vectorized): where the image of the vertical runs within half a pixel of straight down
 // (|fx (nx - x nz)| < down_v / 2) and the lower ray met the terrain, the height gap between the
 // rays must outgrow what the steepest slope makes of the sideways gap (see RenderSignal). Also
-// stores this row's ray slopes and directions and clears its hits.
-CAIRN_SIM_CLONES void ColumnBound(int n, bool enabled, double slope2, double fx_nx, double fx_nz, double half_down_v,
-                 const double* __restrict xs, const double* __restrict dxs, const double* __restrict dys,
-                 const double* __restrict dzs, const double* __restrict inv_hs, const double* __restrict rho_a,
-                 const double* __restrict tan_a, const double* __restrict hx_a, const double* __restrict hy_a,
-                 double* __restrict tan_b, double* __restrict hx_b, double* __restrict hy_b,
-                 double* __restrict rho_b, double* __restrict t_start, double* __restrict bounded) {
+// stores this row's ray slopes and directions, its hits not yet known.
+CAIRN_SIM_CLONES void ColumnBound(int n, bool enabled, double slope2, double fx_nx, double fx_nz,
+                                  double half_down_v, const double* __restrict xs, const double* __restrict dxs,
+                                  const double* __restrict dys, const double* __restrict dzs,
+                                  const double* __restrict inv_hs, const double* __restrict rho_a,
+                                  const double* __restrict tan_a, const double* __restrict hx_a,
+                                  const double* __restrict hy_a, double* __restrict tan_b, double* __restrict hx_b,
+                                  double* __restrict hy_b, double* __restrict rho_b, double* __restrict t_start,
+                                  double* __restrict bounded) {
   for (int i = 0; i < n; ++i) {
     const double inv_h = inv_hs[i];
     const double tan_e = dzs[i] * inv_h, hx = dxs[i] * inv_h, hy = dys[i] * inv_h;
@@ -175,8 +177,9 @@ void CameraRenderer::Render(const RenderScene& scene, const PinholeRadTan& k,
   ApplyNoise(signal, k.width, options, noise_seed, image);
 }
 
-CAIRN_SIM_CLONES void CameraRenderer::ApplyNoise(const std::vector<float>& signal, int width, const RenderOptions& options,
-                                uint64_t noise_seed, std::vector<uint8_t>* image) {
+CAIRN_SIM_CLONES void CameraRenderer::ApplyNoise(const std::vector<float>& signal, int width,
+                                                 const RenderOptions& options, uint64_t noise_seed,
+                                                 std::vector<uint8_t>* image) {
   const auto& gauss = GaussTable();
   image->resize(signal.size());
   const size_t w = static_cast<size_t>(width);
@@ -305,7 +308,8 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
       double spread = 0.0;
       for (const int cu : {tu0, tu1}) {
         for (const int cv : {tv0, tv1}) {
-          spread = std::max(spread, (world_ray(col_x[static_cast<size_t>(cu)], row_y[static_cast<size_t>(cv)]) - centre).norm());
+          const Eigen::Vector3d corner = world_ray(col_x[static_cast<size_t>(cu)], row_y[static_cast<size_t>(cv)]);
+          spread = std::max(spread, (corner - centre).norm());
         }
       }
       tile_clear[tx] = terrain.ClearDistance(origin, centre, spread, options.max_range);
@@ -482,7 +486,9 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
         } else if (seen[j] == Seen::kObject) {
           signal = object_signal[j];
         }
-        if (seen[j] != Seen::kSky && depth_row != nullptr) depth_row[u0 + i] = static_cast<float>(hits[j].t * rays.inv_len[j]);
+        if (seen[j] != Seen::kSky && depth_row != nullptr) {
+          depth_row[u0 + i] = static_cast<float>(hits[j].t * rays.inv_len[j]);  // z of the hit
+        }
         out_row[u0 + i] = static_cast<float>(signal);
       }
     }

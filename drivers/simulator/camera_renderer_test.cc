@@ -65,6 +65,53 @@ TEST(CameraRendererTest, RenderedDepthIsTheTerrainGroundTruth) {
   EXPECT_GT(valid, k.width * k.height / 2);
 }
 
+// Full-size cameras, a forward-looking one (the rover's: the search starts from the hit of the
+// pixel below) and a steep wide-angle one with roll (the hexacopter's: from pixels further down
+// the image of the vertical, or from the tile bounds): every rendered depth is that of the plain
+// ray cast from the camera, and the pixels without depth are the ones whose ray misses.
+TEST(CameraRendererTest, FullSizeCamerasShowTheFirstHitOfEveryRay) {
+  const Terrain terrain = Terrain::Generate(SmallWorld());
+  RenderScene scene;
+  scene.terrain = &terrain;
+  struct View {
+    int width, height;
+    double f, tilt, roll, height_above_ground;
+  };
+  for (const View& view : {View{1024, 508, 1080.0, 0.44, 0.03, 1.3}, View{666, 506, 350.0, 1.05, 0.2, 4.5}}) {
+    PinholeRadTan k;
+    k.width = view.width;
+    k.height = view.height;
+    k.fx = k.fy = view.f;
+    k.cx = (k.width - 1) / 2.0;
+    k.cy = (k.height - 1) / 2.0;
+    Eigen::Isometry3d T = LookingForwardDown(terrain, -7, 1.5, view.height_above_ground);
+    T.linear() = T.linear() * Eigen::AngleAxisd(0.35 - view.tilt, Eigen::Vector3d::UnitX()).toRotationMatrix() *
+                 Eigen::AngleAxisd(view.roll, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    std::vector<uint8_t> img;
+    std::vector<float> depth;
+    CameraRenderer::Render(scene, k, T, RenderOptions{}, 1, &img, &depth);
+    int checked = 0, sky = 0;
+    for (int v = 0; v < k.height; v += 3) {
+      for (int u = v % 7; u < k.width; u += 7) {
+        const Eigen::Vector3d ray((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+        const Eigen::Vector3d dir = T.linear() * ray.normalized();
+        const TerrainHit hit = terrain.Raycast(T.translation(), dir, RenderOptions{}.max_range);
+        const float z = depth[static_cast<size_t>(v * k.width + u)];
+        if (hit.t < 0) {
+          ASSERT_EQ(z, 0.0f) << u << "," << v;
+          ++sky;
+          continue;
+        }
+        const double expected = hit.t * ray.normalized().z();
+        ASSERT_NEAR(z, expected, 1e-6 * expected + 1e-6) << u << "," << v;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, k.width * k.height / 30);
+    (void)sky;
+  }
+}
+
 TEST(CameraRendererTest, SameSeedSameImageAndNoiseDependsOnSeed) {
   const Terrain terrain = Terrain::Generate(SmallWorld());
   RenderScene scene;

@@ -402,7 +402,6 @@ size_t Terrain::memory_bytes() const {
 
 namespace {
 
-using GridRay = Terrain::GridRay;
 using CellHit = Terrain::CellHit;
 
 // The first hit of the ray (grid coordinates o + t d) with the two triangles of cell (ix, iy),
@@ -441,8 +440,10 @@ inline bool HitCell(const float* heights, size_t n, int ix, int iy, double ox, d
 TerrainHit Terrain::Raycast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                             double t_max, double t_start) const {
   CellHit hit;
-  if (!Trace(ToGrid(origin, dir), t_max, t_start, &hit)) return TerrainHit{};
-  return TerrainHit{hit.t, HitNormal(hit)};
+  if (!TraceNear(ToGrid(origin, dir), t_max, t_start, &hit)) return TerrainHit{};
+  const double nx = -hit.a * inv_res_, ny = -hit.b * inv_res_;
+  const double inv_norm = 1.0 / std::sqrt(nx * nx + ny * ny + 1.0);
+  return TerrainHit{hit.t, Eigen::Vector3d(nx * inv_norm, ny * inv_norm, inv_norm)};
 }
 
 inline bool Terrain::TraceNear(const GridRay& r, double t_max, double t_start, CellHit* hit) const {
@@ -493,20 +494,17 @@ inline bool Terrain::TraceNear(const GridRay& r, double t_max, double t_start, C
   return TracePyramid(fallback, t_max, t, hit);
 }
 
-bool Terrain::Trace(const GridRay& r, double t_max, double t_start, CellHit* hit) const {
-  return TraceNear(r, t_max, t_start, hit);
-}
-
 namespace {
 
 constexpr int kRayBatch = 128;
 
 // The start cell of each ray, where the start is inside the grid (straight-line code over arrays,
 // vectorized); elsewhere the search interval is empty (lo = infinity).
-CAIRN_SIM_CLONES void StartCells(int count, double ox, double oy, double oz, double top_height, int cells, int stride,
-                const double* __restrict dxs, const double* __restrict dys, const double* __restrict dzs,
-                const double* __restrict t_max, const double* __restrict t_start, int* __restrict cell,
-                double* __restrict lo, double* __restrict hi, double* __restrict lx, double* __restrict ly) {
+CAIRN_SIM_CLONES void StartCells(int count, double ox, double oy, double oz, double top_height, int cells,
+                                 int stride, const double* __restrict dxs, const double* __restrict dys,
+                                 const double* __restrict dzs, const double* __restrict t_max,
+                                 const double* __restrict t_start, int* __restrict cell, double* __restrict lo,
+                                 double* __restrict hi, double* __restrict lx, double* __restrict ly) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const bool above_all = oz > top_height;
   for (int i = 0; i < count; ++i) {
@@ -525,12 +523,14 @@ CAIRN_SIM_CLONES void StartCells(int count, double ox, double oy, double oz, dou
 
 // HitCell's arithmetic for every ray's start cell, lane by lane (vectorized). The search runs from
 // the start to t_max, the hit confined to the cell's square: the ray's stretch over the cell.
-CAIRN_SIM_CLONES void HitStartCells(int count, double oz, const double* __restrict dxs, const double* __restrict dys,
-                   const double* __restrict dzs, const double* __restrict h00, const double* __restrict h10,
-                   const double* __restrict h01, const double* __restrict h11, const double* __restrict lo,
-                   const double* __restrict hi, const double* __restrict lx, const double* __restrict ly,
-                   double* __restrict hit, double* __restrict th_best, double* __restrict a_best,
-                   double* __restrict b_best) {
+CAIRN_SIM_CLONES void HitStartCells(int count, double oz, const double* __restrict dxs,
+                                    const double* __restrict dys, const double* __restrict dzs,
+                                    const double* __restrict h00, const double* __restrict h10,
+                                    const double* __restrict h01, const double* __restrict h11,
+                                    const double* __restrict lo, const double* __restrict hi,
+                                    const double* __restrict lx, const double* __restrict ly, double* __restrict hit,
+                                    double* __restrict th_best, double* __restrict a_best,
+                                    double* __restrict b_best) {
   constexpr double kTol = 1e-7;
   for (int i = 0; i < count; ++i) {
     const double dx = dxs[i], dy = dys[i], dz = dzs[i];
@@ -585,7 +585,8 @@ CAIRN_SIM_CLONES void Terrain::TraceRays(const RayBatch& rays, CellHit* hits, bo
       } else {
         constexpr double kInf = std::numeric_limits<double>::infinity();
         const double dx = rays.dx[j], dy = rays.dy[j];
-        const GridRay r{rays.ox, rays.oy, oz, dx, dy, rays.dz[j], dx != 0.0 ? 1.0 / dx : kInf, dy != 0.0 ? 1.0 / dy : kInf};
+        const GridRay r{rays.ox, rays.oy, oz, dx, dy, rays.dz[j], dx != 0.0 ? 1.0 / dx : kInf,
+                        dy != 0.0 ? 1.0 / dy : kInf};
         found[j] = TraceNear(r, rays.t_max[j], rays.t_start[j], &hits[j]);
       }
     }
@@ -705,7 +706,10 @@ double Terrain::ClearDistance(const Eigen::Vector3d& origin, const Eigen::Vector
     const double tx = dx > 0 ? ((cx + 1) * s - ox) * inv_dx : dx < 0 ? (cx * s - ox) * inv_dx : inf;
     const double ty = dy > 0 ? ((cy + 1) * s - oy) * inv_dy : dy < 0 ? (cy * s - oy) * inv_dy : inf;
     const double t_exit = std::min({tx, ty, t1});
-    const float hmax = dilated_mip_[mip_offset_[static_cast<size_t>(level)] + static_cast<size_t>(cy) * static_cast<size_t>(mip_width_[static_cast<size_t>(level)]) + static_cast<size_t>(cx)];
+    const size_t node = mip_offset_[static_cast<size_t>(level)] +
+                        static_cast<size_t>(cy) * static_cast<size_t>(mip_width_[static_cast<size_t>(level)]) +
+                        static_cast<size_t>(cx);
+    const float hmax = dilated_mip_[node];
     const double z0 = oz + t * dzl, z1 = oz + t_exit * dzl;
     if (std::min(z0, z1) <= hmax) {
       if (z0 > hmax) {

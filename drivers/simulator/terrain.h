@@ -43,37 +43,22 @@ class Terrain {
   double ClearDistance(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double spread,
                        double t_max) const;
 
-  // Raycast in two steps, for renderers that prepare many rays at once (the preparation has the
-  // divisions and vectorizes; the trace is the scalar search). A ray in grid coordinates: x, y in
-  // cells from the grid's corner, z in metres; t stays the distance along the unit world ray.
-  struct GridRay {
-    double ox, oy, oz, dx, dy, dz, inv_dx, inv_dy;
-  };
-  GridRay ToGrid(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) const {
-    const double dx = dir.x() * inv_res_, dy = dir.y() * inv_res_;
-    constexpr double kInf = std::numeric_limits<double>::infinity();
-    return GridRay{(origin.x() + half_size_) * inv_res_, (origin.y() + half_size_) * inv_res_, origin.z(), dx, dy,
-                   dir.z(), dx != 0.0 ? 1.0 / dx : kInf, dy != 0.0 ? 1.0 / dy : kInf};
-  }
-  // A hit: its distance and the hit triangle's height steps per cell along x and y.
-  struct CellHit {
-    double t = 0.0, a = 0.0, b = 0.0;
-  };
-  bool Trace(const GridRay& ray, double t_max, double t_start, CellHit* hit) const;
-  // Trace for many rays from one origin (grid coordinates), as arrays: ray i searched over
-  // [t_start[i], t_max[i]]; found[i] tells whether hits[i] holds its hit.
+  // Raycast for many rays from one origin, for renderers that prepare rays a row at a time (the
+  // preparation has the divisions and vectorizes). In grid coordinates: x, y in cells from the
+  // grid's corner, z in metres (origin: (x + half_size()) / resolution(), ...; directions: the
+  // unit world direction's x and y over resolution(), its z); t stays the distance along the unit
+  // world ray. Ray i is searched over [t_start[i], t_max[i]]; found[i] tells whether hits[i] holds
+  // its hit: the distance and the hit triangle's height steps per cell along x and y (its normal
+  // is (-a, -b, resolution()), normalized).
   struct RayBatch {
     double ox, oy, oz;
     int count;
     const double *dx, *dy, *dz, *t_max, *t_start;
   };
+  struct CellHit {
+    double t = 0.0, a = 0.0, b = 0.0;
+  };
   void TraceRays(const RayBatch& rays, CellHit* hits, bool* found) const;
-  // The unit normal of a hit triangle: (-a, -b, res) / |(-a, -b, res)|.
-  Eigen::Vector3d HitNormal(const CellHit& hit) const {
-    const double nx = -hit.a * inv_res_, ny = -hit.b * inv_res_;
-    const double inv_norm = 1.0 / std::sqrt(nx * nx + ny * ny + 1.0);
-    return Eigen::Vector3d(nx * inv_norm, ny * inv_norm, inv_norm);
-  }
 
   size_t memory_bytes() const;
   double max_height() const { return flat_mip_.back(); }
@@ -84,6 +69,17 @@ class Terrain {
   float H(int ix, int iy) const { return h_[static_cast<size_t>(iy) * static_cast<size_t>(n_) + static_cast<size_t>(ix)]; }
   void BuildMaxMipmap();
   float AlbedoAt(double x, double y) const;
+  // A ray in grid coordinates (see RayBatch), with the inverses of its horizontal components.
+  struct GridRay {
+    double ox, oy, oz, dx, dy, dz, inv_dx, inv_dy;
+  };
+  GridRay ToGrid(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir) const {
+    const double dx = dir.x() * inv_res_, dy = dir.y() * inv_res_;
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    return GridRay{(origin.x() + half_size_) * inv_res_, (origin.y() + half_size_) * inv_res_, origin.z(), dx, dy,
+                   dir.z(), dx != 0.0 ? 1.0 / dx : kInf, dy != 0.0 ? 1.0 / dy : kInf};
+  }
+  // From t_start, single cells first (a start close to the surface), then TracePyramid.
   bool TraceNear(const GridRay& ray, double t_max, double t_start, CellHit* hit) const;
   bool TracePyramid(const GridRay& ray, double t_max, double t_from, CellHit* hit) const;
   void BuildAlbedo(const WorldOptions& options, const std::vector<Eigen::Vector4d>& rocks);
