@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <numbers>
-#include <thread>
 
 #include "drivers/simulator/candump_format.h"
 #include "drivers/simulator/euroc_writer.h"
@@ -143,9 +143,9 @@ void MissionSimulator::RenderStereo(size_t r, double t, uint64_t frame, std::vec
                                images[c]);
   };
   if (mission_.render_threads > 1) {
-    std::thread right_camera(render_camera, 1);
+    std::future<void> right_camera = std::async(std::launch::async, render_camera, 1);
     render_camera(0);
-    right_camera.join();
+    right_camera.get();
   } else {
     render_camera(0);
     render_camera(1);

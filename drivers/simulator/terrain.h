@@ -2,7 +2,9 @@
 // Procedural planetary-analogue terrain: a height grid (multi-octave noise, craters, boulders,
 // one large crater with a steep rim) made of two planar triangles per cell, an albedo texture with
 // detail at several scales, and a max-mipmap over the cell heights so that a ray finds its first
-// hit by skipping whole quadtree nodes it passes above.
+// hit by skipping whole quadtree nodes it passes above. A renderer starts each ray's search where
+// the ray is known to be clear: a dilated copy of the max-mipmap bounds bundles of neighbouring
+// rays (ClearDistance), and the steepest slope relates rays of neighbouring pixels (max_slope).
 
 #include <cmath>
 #include <cstdint>
