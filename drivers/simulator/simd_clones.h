@@ -5,9 +5,12 @@
 // compute identical bits: rendered images do not depend on the machine that renders them.
 //
 // It belongs on function definitions only: on a declaration in a header, every caller's object
-// file would emit its own resolver for clones that are local to the defining one.
+// file would emit its own resolver for clones that are local to the defining one. ThreadSanitizer
+// builds go without: the loader runs the resolvers before the sanitizer's runtime is set up, and
+// the instrumented resolvers crash.
 
-#if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__)
+#if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_THREAD__)
 #define CAIRN_SIM_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define CAIRN_SIM_CLONES

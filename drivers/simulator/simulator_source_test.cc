@@ -20,6 +20,7 @@ std::shared_ptr<const MissionSimulator> ShortMission() {
   m.robots = {"rover", "hexacopter"};
   m.duration = 0.5;
   m.image_scale = 0.1;
+  m.render_threads = 2;  // as cairnd renders (and so under ThreadSanitizer too)
   auto config = LoadCairndOptions(testing::SourceDir() + "/configs/rover.yaml", {});
   EXPECT_TRUE(config.ok()) << config.status().ToString();
   if (config.ok()) m.can = config->can;
