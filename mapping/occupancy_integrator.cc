@@ -108,9 +108,14 @@ OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, oct
   overflow_.Clear();
   occupied_.clear();
   free_.clear();
-  octomap::OcTreeKey key;
+  octomap::OcTreeKey key, last(0, 0, 0);
+  bool have_last = false;
   for (const Eigen::Vector3f& p : pts.p_local) {
     if (!tree->coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+    // Neighbouring pixels of a row mostly fall into the same 0.1 m voxel.
+    if (have_last && key == last) continue;
+    last = key;
+    have_last = true;
     uint32_t& s = Stamp(key);
     if (s != kOccupied) {
       s = kOccupied;
