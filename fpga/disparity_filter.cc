@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "fpga/stereo_matcher_interface.h"
+#include "fpga/worker_pool.h"
 
 namespace cairn {
 
@@ -89,45 +90,126 @@ void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int 
   }
 }
 
-void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, int max_size,
-                                     int max_diff) {
-  if (max_size <= 0) return;
-  const size_t n = static_cast<size_t>(width) * height;
-  label_.assign(n, 0);  // no reallocation once the size was seen
-  stack_.resize(2 * n);  // (x, y) pairs: no division per visited pixel
-  region_.resize(n);
-  for (int sy = 0; sy < height; ++sy) {
+void DisparityFilter::FillBand(int16_t* disparity, int width, int height, int y0, int y1,
+                               int max_size, int max_diff, Band& band) {
+  const size_t band_pixels = static_cast<size_t>(y1 - y0) * width;
+  std::fill_n(label_.begin() + static_cast<ptrdiff_t>(y0) * width, band_pixels, 0);
+  band.stack.resize(2 * band_pixels);  // (x, y) pairs: no division per visited pixel
+  band.region.resize(band_pixels);
+  band.open.clear();
+  band.open_pixels.clear();
+  int32_t* stack = band.stack.data();
+  int32_t* region = band.region.data();
+  int32_t* label = label_.data();
+  // Rows whose regions may continue into the next band.
+  const int open_top = y0 > 0 ? y0 : -1, open_bottom = y1 < height ? y1 - 1 : -1;
+  for (int sy = y0; sy < y1; ++sy) {
     for (int sx = 0; sx < width; ++sx) {
-      const size_t start = static_cast<size_t>(sy) * width + sx;
-      if (label_[start] != 0 || disparity[start] == kInvalidDisparity) continue;
+      const int32_t start = sy * width + sx;
+      if (label[start] != 0 || disparity[start] == kInvalidDisparity) continue;
       // Flood fill, remembering the members so that a small region can be cleared afterwards.
+      const int32_t id = start + 1;
       int top = 0, count = 0;
-      stack_[top++] = sx;
-      stack_[top++] = sy;
-      label_[start] = 1;
+      bool open = false;
+      stack[top++] = sx;
+      stack[top++] = sy;
+      label[start] = id;
       while (top > 0) {
-        const int py = stack_[--top];
-        const int px = stack_[--top];
+        const int py = stack[--top];
+        const int px = stack[--top];
         const int32_t p = py * width + px;
-        region_[count++] = p;
+        region[count++] = p;
+        open |= py == open_top || py == open_bottom;
         const int16_t dp = disparity[p];
         const auto visit = [&](int qx, int qy) {
           const int32_t q = qy * width + qx;
-          if (label_[q] != 0) return;
+          if (label[q] != 0) return;
           const int16_t dq = disparity[q];
           if (dq == kInvalidDisparity || std::abs(dq - dp) > max_diff) return;
-          label_[q] = 1;
-          stack_[top++] = qx;
-          stack_[top++] = qy;
+          label[q] = id;
+          stack[top++] = qx;
+          stack[top++] = qy;
         };
         if (px > 0) visit(px - 1, py);
         if (px + 1 < width) visit(px + 1, py);
-        if (py > 0) visit(px, py - 1);
-        if (py + 1 < height) visit(px, py + 1);
+        if (py > y0) visit(px, py - 1);
+        if (py + 1 < y1) visit(px, py + 1);
       }
-      if (count < max_size) {
-        for (int i = 0; i < count; ++i) disparity[region_[i]] = kInvalidDisparity;
+      if (open) {
+        band.open.push_back({id, count, band.open_pixels.size()});
+        if (count < max_size) band.open_pixels.insert(band.open_pixels.end(), region, region + count);
+      } else if (count < max_size) {
+        for (int i = 0; i < count; ++i) disparity[region[i]] = kInvalidDisparity;
       }
+    }
+  }
+}
+
+void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, int max_size,
+                                     int max_diff, WorkerPool* pool) {
+  if (max_size <= 0) return;
+  const size_t n = static_cast<size_t>(width) * height;
+  label_.resize(n);  // no reallocation once the size was seen
+  // Bands of at least 32 rows, one per thread.
+  const int bands = std::max(1, std::min(pool != nullptr ? pool->threads() : 1, height / 32));
+  bands_.resize(static_cast<size_t>(bands));
+  const auto band_rows = [&](int b, int* y0, int* y1) {
+    *y0 = static_cast<int>(static_cast<int64_t>(height) * b / bands);
+    *y1 = static_cast<int>(static_cast<int64_t>(height) * (b + 1) / bands);
+  };
+  auto fill = [&](int b) {
+    int y0, y1;
+    band_rows(b, &y0, &y1);
+    FillBand(disparity, width, height, y0, y1, max_size, max_diff, bands_[static_cast<size_t>(b)]);
+  };
+  if (bands == 1) {
+    fill(0);
+    return;
+  }
+  pool->ForEach(bands, fill);
+  // Join the open regions across the band borders (union-find over their ids), then clear the
+  // joined regions that stay small.
+  std::vector<Open*> open;  // by index
+  for (Band& band : bands_) {
+    for (Open& o : band.open) open.push_back(&o);
+  }
+  std::sort(open.begin(), open.end(), [](const Open* a, const Open* b) { return a->id < b->id; });
+  const auto index_of = [&](int32_t id) {
+    const auto it = std::lower_bound(open.begin(), open.end(), id,
+                                     [](const Open* o, int32_t v) { return o->id < v; });
+    return static_cast<int32_t>(it - open.begin());
+  };
+  parent_.resize(open.size());
+  for (size_t i = 0; i < open.size(); ++i) parent_[i] = static_cast<int32_t>(i);
+  const auto find = [&](int32_t i) {
+    while (parent_[static_cast<size_t>(i)] != i) {
+      parent_[static_cast<size_t>(i)] = parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])];
+      i = parent_[static_cast<size_t>(i)];
+    }
+    return i;
+  };
+  std::vector<int64_t> size(open.size());
+  for (size_t i = 0; i < open.size(); ++i) size[i] = open[i]->size;
+  for (int b = 1; b < bands; ++b) {
+    int y0, y1;
+    band_rows(b, &y0, &y1);
+    const int32_t* above = label_.data() + static_cast<size_t>(y0 - 1) * width;
+    const int32_t* below = label_.data() + static_cast<size_t>(y0) * width;
+    const int16_t* da = disparity + static_cast<size_t>(y0 - 1) * width;
+    const int16_t* db = disparity + static_cast<size_t>(y0) * width;
+    for (int x = 0; x < width; ++x) {
+      if (da[x] == kInvalidDisparity || db[x] == kInvalidDisparity) continue;
+      if (std::abs(da[x] - db[x]) > max_diff) continue;
+      const int32_t ra = find(index_of(above[x])), rb = find(index_of(below[x]));
+      if (ra == rb) continue;
+      parent_[static_cast<size_t>(rb)] = ra;
+      size[static_cast<size_t>(ra)] += size[static_cast<size_t>(rb)];
+    }
+  }
+  for (const Band& band : bands_) {
+    for (const Open& o : band.open) {
+      if (o.size >= max_size || size[static_cast<size_t>(find(index_of(o.id)))] >= max_size) continue;
+      for (int32_t i = 0; i < o.size; ++i) disparity[band.open_pixels[o.first_pixel + i]] = kInvalidDisparity;
     }
   }
 }

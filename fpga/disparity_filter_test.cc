@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "fpga/stereo_matcher_interface.h"
+#include "fpga/worker_pool.h"
 
 namespace cairn {
 namespace {
@@ -49,6 +50,42 @@ TEST(DisparityFilterTest, RemovesOnlySmallRegions) {
   EXPECT_EQ(d[3 * w + 4], kInvalidDisparity);
   EXPECT_EQ(d[0], 160);
   EXPECT_EQ(std::count(d.begin(), d.end(), 160), w * h - 2);
+}
+
+// Row bands on threads, joined at the band borders, remove exactly what one flood fill removes.
+TEST(DisparityFilterTest, SpecklesOnThreadsMatchOneThread) {
+  const int w = 83, h = 131;
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 6; ++trial) {
+    // Blocky disparities with noise and holes: regions of every size, many crossing band borders.
+    std::vector<int16_t> d(static_cast<size_t>(w) * h);
+    const int cell = 2 + trial;
+    std::vector<int16_t> cells(static_cast<size_t>((w / cell + 1) * (h / cell + 1)));
+    for (auto& c : cells) c = static_cast<int16_t>(rng() % 6 * 40);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        int16_t v = static_cast<int16_t>(cells[static_cast<size_t>((y / cell) * (w / cell + 1) + x / cell)] +
+                                         rng() % 9);
+        if (rng() % 13 == 0) v = kInvalidDisparity;
+        if (trial % 2 == 1 && x % 17 == 5) v = static_cast<int16_t>(500 + y % 3);  // long thin regions
+        d[static_cast<size_t>(y) * w + x] = v;
+      }
+    }
+    std::vector<int16_t> reference = d;
+    DisparityFilter one;
+    one.RemoveSpeckles(reference.data(), w, h, 10 + 15 * trial, 8);
+    for (int threads : {2, 3}) {
+      WorkerPool pool(threads);
+      DisparityFilter banded;
+      std::vector<int16_t> out = d;
+      banded.RemoveSpeckles(out.data(), w, h, 10 + 15 * trial, 8, &pool);
+      EXPECT_EQ(out, reference) << "trial " << trial << ", " << threads << " threads";
+      out = d;  // buffers reused
+      banded.RemoveSpeckles(out.data(), w, h, 10 + 15 * trial, 8, &pool);
+      EXPECT_EQ(out, reference) << "trial " << trial << ", again";
+    }
+    EXPECT_NE(reference, d);
+  }
 }
 
 TEST(DisparityFilterTest, FillsHolesFromTheFartherSide) {

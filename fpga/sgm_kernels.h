@@ -77,6 +77,46 @@ int SgmSubpixelOffset(int below, int at, int above);
 inline bool SgmLeftRightConsistent(int k, int right_k, int max_diff) {
   return right_k >= 0 && (k > right_k ? k - right_k : right_k - k) <= max_diff;
 }
+// The SIMD backend's own schedule for the four horizontal and vertical paths
+// (SgmMatcher::MatchFourPath): fewer, fused passes, the same arithmetic as the kernels above.
+//
+// Cost inputs of one row. The reversed right census is stored as `planes` = ceil(census bits / 4)
+// nibble planes: nibble b of right(i) is nibbles[b * stride + i]. cost(x, k) is as in
+// SgmKernels::cost; pixels x in [safe_begin, safe_end) have no border lanes.
+struct SgmCostRow {
+  const uint32_t* left = nullptr;
+  const uint8_t* nibbles = nullptr;
+  int stride = 0;
+  int planes = 0;
+  const uint8_t* border = nullptr;
+  int safe_begin = 0, safe_end = 0;
+};
+
+// Path rows here are plain: width * D uint8, no sentinel blocks; every pointer is aligned to 64
+// bytes and has 64 readable bytes before and after.
+struct SgmFourPathKernels {
+  // One vertical path over a row, the cost computed on the fly: out = step(prev) as in
+  // SgmKernels::vertical with one path, out = cost where prev == nullptr (first row of the
+  // sweep); out_min[x] = min_k out(x, k); cost_out (may be null) receives the cost row.
+  void (*vertical)(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
+                   const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
+                   const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
+                   uint8_t* cost_out);
+  // Both horizontal paths of the row (as SgmKernels::horizontal), plus the vertical path rows va
+  // and vb: sum = all four, uint8_t when `narrow` (the caller guarantees 4 path costs <= 255),
+  // else uint16_t. first: a path row of scratch space; scratch: 4 * D bytes.
+  void (*horizontal_sum)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
+                         const uint8_t* p2_table, uint8_t p1, const uint8_t* va,
+                         const uint8_t* vb, uint8_t* first, uint8_t* scratch, void* sum,
+                         bool narrow);
+  // SgmKernels::wta on a sum row of uint8_t (narrow) or uint16_t. scratch: 8 * (rev_base + D +
+  // 64) sums.
+  void (*wta)(const void* sum, bool narrow, const SgmRowGeometry& g, int uniqueness_percent,
+              void* scratch, int16_t* best, int16_t* right_best);
+};
+// nullptr where the dispatched target has no such kernels (HWY_SCALAR).
+const SgmFourPathKernels* SimdFourPathKernels();
+
 // Highway implementation for the best target of this CPU (AVX2, SSE4, NEON, ...).
 const SgmKernels& SimdSgmKernels();
 // Name of the Highway target SimdSgmKernels() dispatches to, for reports.

@@ -40,6 +40,10 @@ class SgmMatcher final : public StereoMatcher {
   struct StageTimes {
     double census_ms = 0, first_half_ms = 0, second_half_ms = 0, median_ms = 0, speckle_ms = 0,
            depth_ms = 0;
+    // The SIMD four-path schedule's second half, split on the first thread: cost and own
+    // vertical path, both horizontal paths with the sum, winner-take-all, left-right check and
+    // sub-pixel offsets.
+    double vertical_ms = 0, horizontal_ms = 0, wta_ms = 0, finish_ms = 0;
   };
   const StageTimes& last_stage_times() const { return times_; }
 
@@ -59,6 +63,28 @@ class SgmMatcher final : public StereoMatcher {
     int prev_y = -1;
   };
 
+  // The SIMD backend's schedule for paths == 4 (SgmFourPathKernels): a top-down and a bottom-up
+  // sweep, each on its own thread, first run over their own half of the image computing only
+  // their vertical path, which they leave in an 8-bit volume (W x H x D uint8, the only full-size
+  // buffer). Then each continues into the other half, where the volume holds the opposite
+  // vertical path, and finishes every row there: its own vertical path, both horizontal paths,
+  // the sum (uint8 when four path costs cannot exceed 255), winner-take-all.
+  struct FourPathLane {
+    Buffer<uint8_t> cost, state[2], mins[2], first, scratch, nibbles, border, sum, wta_scratch;
+    Buffer<int16_t> best, right_best;
+    const uint8_t* prev = nullptr;  // the path row of the previous row of the sweep
+    const uint8_t* prev_min = nullptr;
+    int prev_y = -1;
+    int cur_min = 0, cur_state = 0;
+  };
+  void AllocateFourPath();
+  void MatchFourPath();
+  // The four-path vertical step of row y (cost computed on the fly), continuing the lane's sweep.
+  void FourPathVertical(FourPathLane& l, int y, uint8_t* out, uint8_t* cost_out);
+  uint8_t* VolumeRow(int y) const {
+    return volume_.get() + 64 + static_cast<size_t>(y) * width_ * geometry_.disparities;
+  }
+
   explicit SgmMatcher(const SgmOptions& options);
   void Allocate(int width, int height);
   void PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, int y1) const;
@@ -73,6 +99,9 @@ class SgmMatcher final : public StereoMatcher {
   // disparities.
   void RasterRow(Sweep& s, int y);
   void FinishRow(Sweep& s, int y);
+  // Left-right check and sub-pixel offsets of row y from its winners and sums.
+  template <class SumT>
+  void FinishPixels(const SumT* sum, const int16_t* best, const int16_t* right_best, int y);
   const uint8_t* image_row(int y) const { return pad_left_.get() + (y + ry_) * pad_stride_ + rx_; }
 
   SgmOptions options_;
@@ -89,6 +118,10 @@ class SgmMatcher final : public StereoMatcher {
   Buffer<uint16_t> sum_;
   Buffer<int16_t> raw_, filtered_;
   Sweep sweeps_[2];
+  const SgmFourPathKernels* four_path_ = nullptr;  // set: MatchFourPath is used
+  bool narrow_sums_ = false;
+  Buffer<uint8_t> volume_;
+  FourPathLane lanes_[2];
   DisparityFilter filter_;
   size_t buffer_bytes_ = 0;
   StageTimes times_;
