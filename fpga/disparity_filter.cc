@@ -8,6 +8,11 @@
 
 namespace cairn {
 
+// The interior pixels [x0, x1) of a row in SIMD vectors (disparity_filter_simd.cc); returns
+// where the scalar loop has to continue.
+int MedianInteriorRow(const int16_t* u, const int16_t* c, const int16_t* d, int16_t* o, int x0,
+                      int x1);
+
 namespace {
 
 // Median of the valid values among the 3x3 neighbours of (x, y); the centre is valid.
@@ -45,10 +50,11 @@ void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int 
     }
     const int16_t* u = c - width;
     const int16_t* d = c + width;
+    const int x_simd = MedianInteriorRow(u, c, d, o, 1, width - 1);
     // Interior: a branch-free odd-even transposition sort of the 9 values (9 rounds sort 9
     // inputs), vectorized by the compiler. kInvalidDisparity is the smallest int16, so the
     // invalid values come first and the median of the n valid ones sits at 9 - n + (n - 1) / 2.
-    for (int x = 1; x < width - 1; ++x) {
+    for (int x = x_simd; x < width - 1; ++x) {
       int16_t p0 = u[x - 1], p1 = u[x], p2 = u[x + 1], p3 = c[x - 1], p4 = c[x], p5 = c[x + 1],
               p6 = d[x - 1], p7 = d[x], p8 = d[x + 1];
       const int16_t centre = p4;

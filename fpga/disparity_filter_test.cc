@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -24,8 +26,16 @@ int16_t ReferenceMedian(const std::vector<int16_t>& in, int w, int h, int x, int
   return v[(v.size() - 1) / 2];
 }
 
+void MedianCase(int w, int h);
+
 TEST(DisparityFilterTest, MedianMatchesTheDefinitionWithInvalidPixels) {
-  const int w = 37, h = 11;
+  for (const auto& [w, h] : {std::pair{37, 11}, std::pair{203, 9}, std::pair{3, 5}}) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    MedianCase(w, h);
+  }
+}
+
+void MedianCase(int w, int h) {
   std::mt19937 rng(5);
   std::vector<int16_t> in(w * h), out(w * h);
   for (auto& d : in) d = rng() % 7 == 0 ? kInvalidDisparity : static_cast<int16_t>(rng() % 2000 - 500);

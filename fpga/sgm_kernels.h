@@ -102,17 +102,19 @@ struct SgmFourPathKernels {
                    const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
                    const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
                    uint8_t* cost_out);
-  // Both horizontal paths of the row (as SgmKernels::horizontal), plus the vertical path rows va
-  // and vb: sum = all four, uint8_t when `narrow` (the caller guarantees 4 path costs <= 255),
-  // else uint16_t. first: a path row of scratch space; scratch: 4 * D bytes.
-  void (*horizontal_sum)(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                         const uint8_t* p2_table, uint8_t p1, const uint8_t* va,
-                         const uint8_t* vb, uint8_t* first, uint8_t* scratch, void* sum,
-                         bool narrow);
-  // SgmKernels::wta on a sum row of uint8_t (narrow) or uint16_t. scratch: 8 * (rev_base + D +
-  // 64) sums.
-  void (*wta)(const void* sum, bool narrow, const SgmRowGeometry& g, int uniqueness_percent,
-              void* scratch, int16_t* best, int16_t* right_best);
+  // A row of the second half, complete: its cost, the own vertical path (as `vertical`, prev ->
+  // out), both horizontal paths (as SgmKernels::horizontal), their sum with the opposite
+  // vertical path vb, and winner-take-all as SgmKernels::wta (best, right_best); offset[x] is the
+  // sub-pixel offset at best (SgmSubpixelOffset) with `subpixel` and 0 < best < D - 1, else 0.
+  // Sums are uint8 when `narrow` (the caller guarantees that four path costs stay <= 255), else
+  // uint16. partial: width * D sums of scratch space; scratch: 4 D + 4 D + 64 bytes plus 8
+  // (rev_base + D + 96) sums.
+  void (*finish_row)(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
+                     const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
+                     const uint8_t* prev, const uint8_t* prev_min, uint8_t* out,
+                     uint8_t* out_min, const uint8_t* vb, int uniqueness_percent, bool subpixel,
+                     bool narrow, void* partial, uint8_t* scratch, int16_t* best,
+                     int16_t* offset, int16_t* right_best);
 };
 // nullptr where the dispatched target has no such kernels (HWY_SCALAR).
 const SgmFourPathKernels* SimdFourPathKernels();

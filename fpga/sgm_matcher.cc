@@ -129,23 +129,21 @@ void SgmMatcher::AllocateFourPath() {
   const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
   const size_t planes = (static_cast<size_t>(options_.census_bits()) + 3) / 4;
   for (FourPathLane& l : lanes_) {
-    l.cost = AllocateBuffer<uint8_t>(row, &buffer_bytes_);
     for (int b = 0; b < 2; ++b) {
       l.state[b] = AllocateBuffer<uint8_t>(row + 128, &buffer_bytes_);
       l.mins[b] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
     }
-    l.first = AllocateBuffer<uint8_t>(row, &buffer_bytes_);
-    l.scratch = AllocateBuffer<uint8_t>(4 * d + 64, &buffer_bytes_);
+    l.partial = AllocateBuffer<uint8_t>(row * 2, &buffer_bytes_);
+    l.scratch = AllocateBuffer<uint8_t>(8 * d + 64 + 16 * (n_rev + 96), &buffer_bytes_);
     l.nibbles = AllocateBuffer<uint8_t>(planes * n_rev + 64, &buffer_bytes_);
     l.border = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
-    l.sum = AllocateBuffer<uint8_t>(row * 2, &buffer_bytes_);
-    l.wta_scratch = AllocateBuffer<uint8_t>(8 * n_rev * 2, &buffer_bytes_);
     l.best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
+    l.offset = AllocateBuffer<int16_t>(w, &buffer_bytes_);
     l.right_best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
   }
 }
 
-void SgmMatcher::FourPathVertical(FourPathLane& l, int y, uint8_t* out, uint8_t* cost_out) {
+SgmCostRow SgmMatcher::FourPathCostRow(FourPathLane& l, int y) {
   const SgmRowGeometry& g = geometry_;
   const int n_rev = g.rev_base + g.disparities;
   const int stride = n_rev + 64;  // as allocated
@@ -171,10 +169,31 @@ void SgmMatcher::FourPathVertical(FourPathLane& l, int y, uint8_t* out, uint8_t*
   // x - d_min - k is inside the right image for every k.
   c.safe_begin = std::max(0, g.min_disparity + g.disparities - 1);
   c.safe_end = std::min(width_, width_ + g.min_disparity);
+  return c;
+}
+
+void SgmMatcher::FourPathVertical(FourPathLane& l, int y, uint8_t* out) {
+  const SgmCostRow c = FourPathCostRow(l, y);
   uint8_t* out_min = l.mins[l.cur_min].get();
-  four_path_->vertical(c, g, image_row(y), l.prev != nullptr ? image_row(l.prev_y) : nullptr,
-                       p2_table_, static_cast<uint8_t>(options_.p1), l.prev, l.prev_min, out,
-                       out_min, cost_out);
+  four_path_->vertical(c, geometry_, image_row(y),
+                       l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
+                       static_cast<uint8_t>(options_.p1), l.prev, l.prev_min, out, out_min,
+                       nullptr);
+  l.prev = out;
+  l.prev_min = out_min;
+  l.prev_y = y;
+  l.cur_min ^= 1;
+}
+
+void SgmMatcher::FourPathFinish(FourPathLane& l, int y, uint8_t* out) {
+  const SgmCostRow c = FourPathCostRow(l, y);
+  uint8_t* out_min = l.mins[l.cur_min].get();
+  four_path_->finish_row(c, geometry_, image_row(y),
+                         l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
+                         static_cast<uint8_t>(options_.p1), l.prev, l.prev_min, out, out_min,
+                         VolumeRow(y), static_cast<int>(options_.uniqueness_percent),
+                         options_.subpixel, narrow_sums_, l.partial.get(), l.scratch.get(),
+                         l.best.get(), l.offset.get(), l.right_best.get());
   l.prev = out;
   l.prev_min = out_min;
   l.prev_y = y;
@@ -194,17 +213,15 @@ void SgmMatcher::MatchFourPath() {
   pool_.ForEach(2, [&](int t) {
     FourPathLane& l = lanes_[t];
     if (t == 0) {
-      for (int y = 0; y < half; ++y) FourPathVertical(l, y, VolumeRow(y), nullptr);
+      for (int y = 0; y < half; ++y) FourPathVertical(l, y, VolumeRow(y));
     } else {
-      for (int y = h - 1; y >= half; --y) FourPathVertical(l, y, VolumeRow(y), nullptr);
+      for (int y = h - 1; y >= half; --y) FourPathVertical(l, y, VolumeRow(y));
     }
   });
   times_.first_half_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   const auto t1 = Clock::now();
   // The other half, where the volume holds the opposite vertical path: every row finishes.
-  const uint8_t p1 = static_cast<uint8_t>(options_.p1);
-  const int uniqueness = static_cast<int>(options_.uniqueness_percent);
-  double split[4] = {0, 0, 0, 0};
+  double split[2] = {0, 0};
   pool_.ForEach(2, [&](int t) {
     FourPathLane& l = lanes_[t];
     auto mark = Clock::now();
@@ -217,22 +234,10 @@ void SgmMatcher::MatchFourPath() {
     const auto finish = [&](int y) {
       uint8_t* own = l.state[l.cur_state].get() + 64;
       l.cur_state ^= 1;
-      FourPathVertical(l, y, own, l.cost.get());
+      FourPathFinish(l, y, own);
       lap(0);
-      four_path_->horizontal_sum(l.cost.get(), image_row(y), geometry_, p2_table_, p1, own,
-                                 VolumeRow(y), l.first.get(), l.scratch.get(), l.sum.get(),
-                                 narrow_sums_);
+      FinishPixels(l.best.get(), l.offset.get(), l.right_best.get(), y);
       lap(1);
-      four_path_->wta(l.sum.get(), narrow_sums_, geometry_, uniqueness, l.wta_scratch.get(),
-                      l.best.get(), l.right_best.get());
-      lap(2);
-      if (narrow_sums_) {
-        FinishPixels(l.sum.get(), l.best.get(), l.right_best.get(), y);
-      } else {
-        FinishPixels(reinterpret_cast<const uint16_t*>(l.sum.get()), l.best.get(),
-                     l.right_best.get(), y);
-      }
-      lap(3);
     };
     if (t == 0) {
       for (int y = half; y < h; ++y) finish(y);
@@ -241,10 +246,8 @@ void SgmMatcher::MatchFourPath() {
     }
   });
   times_.second_half_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
-  times_.vertical_ms = split[0];
-  times_.horizontal_ms = split[1];
-  times_.wta_ms = split[2];
-  times_.finish_ms = split[3];
+  times_.row_pass_ms = split[0];
+  times_.lr_check_ms = split[1];
 }
 
 void SgmMatcher::PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, int y1) const {
@@ -335,6 +338,23 @@ void SgmMatcher::FinishRow(Sweep& s, int y) {
   kernels_->wta(s.row_sum.get(), geometry_, static_cast<int>(options_.uniqueness_percent),
                 s.wta_scratch.get(), s.best.get(), s.right_best.get());
   FinishPixels(s.row_sum.get(), s.best.get(), s.right_best.get(), y);
+}
+
+void SgmMatcher::FinishPixels(const int16_t* best, const int16_t* offset,
+                              const int16_t* right_best, int y) {
+  const SgmRowGeometry& g = geometry_;
+  int16_t* out = raw_.get() + static_cast<size_t>(y) * width_;
+  const int max_diff = static_cast<int>(options_.lr_max_diff);
+  for (int x = 0; x < width_; ++x) {
+    out[x] = kInvalidDisparity;
+    const int k = best[x];
+    if (k < 0) continue;  // not unique
+    const int d = g.min_disparity + k;
+    const int xr = x - d;
+    if (xr < 0 || xr >= width_) continue;  // matched outside the right image
+    if (options_.lr_check && !SgmLeftRightConsistent(k, right_best[xr], max_diff)) continue;
+    out[x] = static_cast<int16_t>(d * kDisparityScale + offset[x]);
+  }
 }
 
 template <class SumT>

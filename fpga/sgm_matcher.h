@@ -40,10 +40,10 @@ class SgmMatcher final : public StereoMatcher {
   struct StageTimes {
     double census_ms = 0, first_half_ms = 0, second_half_ms = 0, median_ms = 0, speckle_ms = 0,
            depth_ms = 0;
-    // The SIMD four-path schedule's second half, split on the first thread: cost and own
-    // vertical path, both horizontal paths with the sum, winner-take-all, left-right check and
-    // sub-pixel offsets.
-    double vertical_ms = 0, horizontal_ms = 0, wta_ms = 0, finish_ms = 0;
+    // The SIMD four-path schedule's second half on the first thread: the fused row pass (cost,
+    // own vertical and both horizontal paths, sum, winner-take-all, uniqueness, sub-pixel), then
+    // the left-right check.
+    double row_pass_ms = 0, lr_check_ms = 0;
   };
   const StageTimes& last_stage_times() const { return times_; }
 
@@ -70,8 +70,8 @@ class SgmMatcher final : public StereoMatcher {
   // vertical path, and finishes every row there: its own vertical path, both horizontal paths,
   // the sum (uint8 when four path costs cannot exceed 255), winner-take-all.
   struct FourPathLane {
-    Buffer<uint8_t> cost, state[2], mins[2], first, scratch, nibbles, border, sum, wta_scratch;
-    Buffer<int16_t> best, right_best;
+    Buffer<uint8_t> state[2], mins[2], partial, scratch, nibbles, border;
+    Buffer<int16_t> best, offset, right_best;
     const uint8_t* prev = nullptr;  // the path row of the previous row of the sweep
     const uint8_t* prev_min = nullptr;
     int prev_y = -1;
@@ -79,8 +79,11 @@ class SgmMatcher final : public StereoMatcher {
   };
   void AllocateFourPath();
   void MatchFourPath();
-  // The four-path vertical step of row y (cost computed on the fly), continuing the lane's sweep.
-  void FourPathVertical(FourPathLane& l, int y, uint8_t* out, uint8_t* cost_out);
+  // The cost inputs of row y (SgmCostRow) from the lane's buffers.
+  SgmCostRow FourPathCostRow(FourPathLane& l, int y);
+  // Continues the lane's sweep with row y: only the vertical path (first half), or the whole row.
+  void FourPathVertical(FourPathLane& l, int y, uint8_t* out);
+  void FourPathFinish(FourPathLane& l, int y, uint8_t* out);
   uint8_t* VolumeRow(int y) const {
     return volume_.get() + 64 + static_cast<size_t>(y) * width_ * geometry_.disparities;
   }
@@ -102,6 +105,8 @@ class SgmMatcher final : public StereoMatcher {
   // Left-right check and sub-pixel offsets of row y from its winners and sums.
   template <class SumT>
   void FinishPixels(const SumT* sum, const int16_t* best, const int16_t* right_best, int y);
+  // The same from sub-pixel offsets computed already (0 where none applies).
+  void FinishPixels(const int16_t* best, const int16_t* offset, const int16_t* right_best, int y);
   const uint8_t* image_row(int y) const { return pad_left_.get() + (y + ry_) * pad_stride_ + rx_; }
 
   SgmOptions options_;

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
+#include <type_traits>
 #include <utility>
 
 #include "fpga/sgm_kernels.h"
@@ -131,185 +132,299 @@ void VerticalImpl(D d, const SgmCostRow& c, const SgmRowGeometry& g, const uint8
   }
 }
 
-// One step of a horizontal path at pixel x: out = step(prev), returns min out in every lane. The
-// first of the two horizontal paths to reach x leaves its costs in `first`; the second adds
-// them, the two vertical paths va, vb and its own into sum.
-template <bool kSecond, class SumT, class D>
-HWY_INLINE hn::Vec<D> ChainStep(D d, int dc, const uint8_t* cost, const uint8_t* prev,
-                                uint8_t* out, hn::Vec<D> vmp, hn::Vec<D> vp1, uint8_t p2,
-                                uint8_t* first, const uint8_t* va, const uint8_t* vb, SumT* sum) {
+// Everything one row of the second half needs, for the per-pixel visits below.
+struct RowArgs {
+  const SgmCostRow* c;
+  const SgmRowGeometry* g;
+  const uint8_t* image_row;
+  const uint8_t* prev_image_row;
+  const uint8_t* p2_table;
+  uint8_t p1;
+  const uint8_t* prev;  // the own vertical path of the previous row (nullptr: none)
+  const uint8_t* prev_min;
+  uint8_t* out;
+  uint8_t* out_min;
+  const uint8_t* vb;  // the opposite vertical path (volume row)
+  void* partial;      // horizontal path of the first visit + both vertical paths, per pixel
+  int uniqueness_percent;
+  bool subpixel;
+  int16_t* best;
+  int16_t* offset;
+};
+
+// The cost lookup tables of pixel x: popcount(l ^ r) = sum over the nibbles b of
+// tab[b][r nibble b].
+template <int kPlanes, class D>
+HWY_INLINE void CostTables(D d, const SgmCostRow& c, int x, hn::Vec<D>* tab) {
+  const int planes = kPlanes > 0 ? kPlanes : c.planes;
+  const uint32_t l = c.left[x];
+  for (int b = 0; b < planes; ++b) tab[b] = hn::LoadDup128(d, kNibbleDistance.v[(l >> (4 * b)) & 15]);
+}
+
+template <int kPlanes, class D>
+HWY_INLINE hn::Vec<D> CostAt(D d, const SgmCostRow& c, const hn::Vec<D>* tab, const uint8_t* right,
+                             const uint8_t* border, bool at_border, int k) {
+  const int planes = kPlanes > 0 ? kPlanes : c.planes;
+  auto cost = hn::TableLookupBytes(tab[0], hn::LoadU(d, right + k));
+  for (int b = 1; b < planes; ++b) {
+    cost = hn::Add(cost, hn::TableLookupBytes(tab[b], hn::LoadU(d, right + b * c.stride + k)));
+  }
+  if (at_border) cost = hn::Max(cost, hn::LoadU(d, border + k));
+  return cost;
+}
+
+// The first of the two horizontal paths to reach pixel x: its cost, the own vertical path (prev
+// -> out), the horizontal step hprev -> hout (returns its minimum in every lane), and the
+// partial sum of these two and the opposite vertical path.
+template <int kPlanes, class SumT, class D>
+HWY_INLINE hn::Vec<D> FirstVisit(D d, const RowArgs& a, int x, const uint8_t* hprev, uint8_t* hout,
+                                 hn::Vec<D> vmp, uint8_t p2h) {
   using V = hn::Vec<D>;
+  const SgmCostRow& c = *a.c;
+  const SgmRowGeometry& g = *a.g;
   const int n = static_cast<int>(hn::Lanes(d));
+  const int dc = g.disparities;
+  const size_t at = static_cast<size_t>(x) * dc;
+  V tab[8];
+  CostTables<kPlanes>(d, c, x, tab);
+  const uint8_t* right = c.nibbles + (g.rev_base - x);
+  const uint8_t* border = c.border + (g.rev_base - x);
+  const bool at_border = x < c.safe_begin || x >= c.safe_end;
   const V ff = hn::Set(d, uint8_t{0xFF});
-  const V jump = hn::SaturatedAdd(vmp, hn::Set(d, p2));
-  V best = ff;
-  V before = ff;
-  V pv = hn::Load(d, prev);
+  const V vp1 = hn::Set(d, a.p1);
+  const uint8_t* lp = a.prev != nullptr ? a.prev + at : nullptr;
+  V vmv = hn::Zero(d), jv = hn::Zero(d);
+  if (lp != nullptr) {
+    vmv = hn::Set(d, a.prev_min[x]);
+    jv = hn::SaturatedAdd(vmv, hn::Set(d, a.p2_table[std::abs(a.image_row[x] - a.prev_image_row[x])]));
+  }
+  const V jh = hn::SaturatedAdd(vmp, hn::Set(d, p2h));
+  V best_v = ff, best_h = ff, before = ff;
+  V pv = hn::Load(d, hprev);
   for (int k = 0; k < dc; k += n) {
-    const V after = k + n < dc ? hn::Load(d, prev + k + n) : ff;
-    const V m = hn::Min(hn::Min(pv, jump),
+    const V cost = CostAt<kPlanes>(d, c, tab, right, border, at_border, k);
+    V ov = cost;
+    if (lp != nullptr) {
+      V lm = hn::LoadU(d, lp + k - 1);
+      V lq = hn::LoadU(d, lp + k + 1);
+      if (k == 0) lm = hn::Or(lm, hn::IfThenElseZero(hn::FirstN(d, 1), ff));
+      if (k + n == dc) lq = hn::Or(lq, hn::IfThenZeroElse(hn::FirstN(d, static_cast<size_t>(n - 1)), ff));
+      const V m = hn::Min(hn::Min(hn::Load(d, lp + k), jv), hn::SaturatedAdd(hn::Min(lm, lq), vp1));
+      ov = hn::Add(cost, hn::Sub(m, vmv));
+    }
+    hn::Store(ov, d, a.out + at + k);
+    best_v = hn::Min(best_v, ov);
+    const V after = k + n < dc ? hn::Load(d, hprev + k + n) : ff;
+    const V m = hn::Min(hn::Min(pv, jh),
                         hn::SaturatedAdd(hn::Min(Before(d, pv, before), After(d, pv, after)), vp1));
-    const V o = hn::Add(hn::Load(d, cost + k), hn::Sub(m, vmp));
-    hn::Store(o, d, out + k);
-    best = hn::Min(best, o);
-    if constexpr (!kSecond) {
-      hn::Store(o, d, first + k);
-    } else if constexpr (sizeof(SumT) == 1) {
-      // Narrow sums: the matcher checked that four path costs cannot exceed 255.
-      const V s = hn::Add(hn::Add(o, hn::Load(d, first + k)),
-                          hn::Add(hn::Load(d, va + k), hn::Load(d, vb + k)));
-      hn::Store(s, d, reinterpret_cast<uint8_t*>(sum) + k);
+    const V oh = hn::Add(cost, hn::Sub(m, vmp));
+    hn::Store(oh, d, hout + k);
+    best_h = hn::Min(best_h, oh);
+    const V vb = hn::Load(d, a.vb + at + k);
+    if constexpr (sizeof(SumT) == 1) {
+      // Narrow sums: four path costs, so also three, cannot exceed 255 (the matcher checked).
+      hn::Store(hn::Add(hn::Add(oh, ov), vb), d, static_cast<uint8_t*>(a.partial) + at + k);
     } else {
       const hn::Half<D> dh;
       const hn::Rebind<uint16_t, decltype(dh)> dw;
-      const int nh = n / 2;
-      auto lo = hn::Add(hn::Add(hn::PromoteTo(dw, hn::LowerHalf(dh, o)),
-                                hn::PromoteTo(dw, hn::Load(dh, first + k))),
-                        hn::Add(hn::PromoteTo(dw, hn::Load(dh, va + k)),
-                                hn::PromoteTo(dw, hn::Load(dh, vb + k))));
-      auto hi = hn::Add(hn::Add(hn::PromoteTo(dw, hn::UpperHalf(dh, o)),
-                                hn::PromoteTo(dw, hn::LoadU(dh, first + k + nh))),
-                        hn::Add(hn::PromoteTo(dw, hn::LoadU(dh, va + k + nh)),
-                                hn::PromoteTo(dw, hn::LoadU(dh, vb + k + nh))));
-      hn::Store(lo, dw, sum + k);
-      hn::Store(hi, dw, sum + k + nh);
+      uint16_t* p = static_cast<uint16_t*>(a.partial) + at + k;
+      hn::Store(hn::Add(hn::Add(hn::PromoteTo(dw, hn::LowerHalf(dh, oh)),
+                                hn::PromoteTo(dw, hn::LowerHalf(dh, ov))),
+                        hn::PromoteTo(dw, hn::LowerHalf(dh, vb))),
+                dw, p);
+      hn::Store(hn::Add(hn::Add(hn::PromoteTo(dw, hn::UpperHalf(dh, oh)),
+                                hn::PromoteTo(dw, hn::UpperHalf(dh, ov))),
+                        hn::PromoteTo(dw, hn::UpperHalf(dh, vb))),
+                dw, p + n / 2);
     }
     before = pv;
     pv = after;
   }
-  return MinAllU8(d, best);
+  a.out_min[x] = hn::GetLane(MinAllU8(d, best_v));
+  return MinAllU8(d, best_h);
 }
 
-// Left-to-right and right-to-left in one loop (two independent dependency chains), then the sum
-// of all four paths.
-template <class SumT, class D>
-void HorizontalSumImpl(D d, const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                       const uint8_t* p2_table, uint8_t p1, const uint8_t* va, const uint8_t* vb,
-                       uint8_t* first, uint8_t* scratch, SumT* sum) {
+// Right-image minima: one copy per direction of the second visits and x parity, so that no load
+// waits for the store of the pixel before. Ascending x keeps the first of equal sums (strict <),
+// descending x the last (<=): both the smallest k, as the golden model's scan.
+template <class T>
+struct RightMinima {
+  T* min[4];
+  T* k[4];
+};
+
+// The second of the two horizontal paths to reach pixel x: its step, the complete sum (into
+// `sums`, one pixel), winner-take-all with the uniqueness test, the sub-pixel offset and the
+// right-image minima.
+template <int kPlanes, class SumT, bool kAscending, class D>
+HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* hprev,
+                                  uint8_t* hout, hn::Vec<D> vmp, uint8_t p2h, SumT* sums,
+                                  const RightMinima<std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>>& rm) {
   using V = hn::Vec<D>;
+  using T = std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>;
+  const SgmCostRow& c = *a.c;
+  const SgmRowGeometry& g = *a.g;
+  const int n = static_cast<int>(hn::Lanes(d));
+  const int dc = g.disparities;
+  const size_t at = static_cast<size_t>(x) * dc;
+  V tab[8];
+  CostTables<kPlanes>(d, c, x, tab);
+  const uint8_t* right = c.nibbles + (g.rev_base - x);
+  const uint8_t* border = c.border + (g.rev_base - x);
+  const bool at_border = x < c.safe_begin || x >= c.safe_end;
+  const V ff = hn::Set(d, uint8_t{0xFF});
+  const V vp1 = hn::Set(d, a.p1);
+  const V jh = hn::SaturatedAdd(vmp, hn::Set(d, p2h));
+  V best_h = ff, before = ff;
+  V pv = hn::Load(d, hprev);
+  for (int k = 0; k < dc; k += n) {
+    const V cost = CostAt<kPlanes>(d, c, tab, right, border, at_border, k);
+    const V after = k + n < dc ? hn::Load(d, hprev + k + n) : ff;
+    const V m = hn::Min(hn::Min(pv, jh),
+                        hn::SaturatedAdd(hn::Min(Before(d, pv, before), After(d, pv, after)), vp1));
+    const V oh = hn::Add(cost, hn::Sub(m, vmp));
+    hn::Store(oh, d, hout + k);
+    best_h = hn::Min(best_h, oh);
+    if constexpr (sizeof(SumT) == 1) {
+      hn::Store(hn::Add(oh, hn::Load(d, static_cast<const uint8_t*>(a.partial) + at + k)), d, sums + k);
+    } else {
+      const hn::Half<D> dh;
+      const hn::Rebind<uint16_t, decltype(dh)> dw;
+      const uint16_t* p = static_cast<const uint16_t*>(a.partial) + at + k;
+      hn::Store(hn::Add(hn::PromoteTo(dw, hn::LowerHalf(dh, oh)), hn::Load(dw, p)), dw, sums + k);
+      hn::Store(hn::Add(hn::PromoteTo(dw, hn::UpperHalf(dh, oh)), hn::Load(dw, p + n / 2)), dw,
+                sums + k + n / 2);
+    }
+    before = pv;
+    pv = after;
+  }
+  // Winner-take-all of pixel x (as WtaScalar).
+  const hn::Repartition<T, D> dt;
+  using VT = hn::Vec<decltype(dt)>;
+  constexpr uint32_t kMaxT = sizeof(T) == 1 ? 0xFF : 0x7FFF;
+  const int nt = static_cast<int>(hn::Lanes(dt));
+  const T* s = reinterpret_cast<const T*>(sums);
+  VT vmin = hn::Load(dt, s);
+  for (int k = nt; k < dc; k += nt) vmin = hn::Min(vmin, hn::Load(dt, s + k));
+  T m;
+  if constexpr (sizeof(T) == 1) {
+    m = hn::GetLane(MinAllU8(dt, vmin));
+  } else {
+    m = hn::GetLane(hn::MinOfLanes(dt, vmin));
+  }
+  const VT vm = hn::Set(dt, m);
+  int bk = 0;
+  for (int k = 0; k < dc; k += nt) {
+    const intptr_t f = hn::FindFirstTrue(dt, hn::Eq(hn::Load(dt, s + k), vm));
+    if (f >= 0) {
+      bk = k + static_cast<int>(f);
+      break;
+    }
+  }
+  // Not unique iff a sum outside bk-1..bk+1 is below t = ceil(100 m / (100 - u)).
+  const uint32_t keep = static_cast<uint32_t>(100 - a.uniqueness_percent);
+  bool unique = true;
+  if (keep < 100 && m > 0) {
+    const uint32_t t = (static_cast<uint32_t>(m) * 100u + keep - 1) / keep;
+    size_t below = static_cast<size_t>(dc);
+    if (t <= kMaxT) {
+      below = 0;
+      const VT vt1 = hn::Set(dt, static_cast<T>(t - 1));
+      for (int k = 0; k < dc; k += nt) {
+        const VT v = hn::Load(dt, s + k);
+        below += hn::CountTrue(dt, hn::Eq(hn::Min(v, vt1), v));  // v <= t - 1
+      }
+    }
+    size_t near = 0;
+    for (int k = std::max(0, bk - 1); k <= std::min(dc - 1, bk + 1); ++k) {
+      near += static_cast<uint32_t>(s[k]) < t;
+    }
+    unique = below == near;
+  }
+  a.best[x] = static_cast<int16_t>(unique ? bk : -1 - bk);
+  a.offset[x] = static_cast<int16_t>(a.subpixel && bk > 0 && bk < dc - 1
+                                         ? SgmSubpixelOffset(s[bk - 1], s[bk], s[bk + 1])
+                                         : 0);
+  // The right-image minima over the diagonal of x.
+  const int copy = (kAscending ? 0 : 2) + (x & 1);
+  T* rmin = rm.min[copy] + (g.rev_base - x);
+  T* rk = rm.k[copy] + (g.rev_base - x);
+  VT kv = hn::Iota(dt, 0);
+  const VT vn = hn::Set(dt, static_cast<T>(nt));
+  for (int k = 0; k < dc; k += nt) {
+    const VT v = hn::Load(dt, s + k);
+    const VT mo = hn::LoadU(dt, rmin + k);
+    const VT nm = hn::Min(v, mo);
+    // Takes v where v < mo (ascending) or v <= mo (descending).
+    const auto take = kAscending ? hn::Not(hn::Eq(nm, mo)) : hn::Eq(nm, v);
+    hn::StoreU(hn::IfThenElse(take, kv, hn::LoadU(dt, rk + k)), dt, rk + k);
+    hn::StoreU(nm, dt, rmin + k);
+    kv = hn::Add(kv, vn);
+  }
+  return MinAllU8(d, best_h);
+}
+
+// A whole row of the second half; both horizontal directions advance in one loop (two
+// independent dependency chains, the per-pixel work of either fills the other's wait).
+template <int kPlanes, class SumT, class D>
+void FinishRowImpl(D d, const RowArgs& a, uint8_t* scratch, int16_t* right_best) {
+  using V = hn::Vec<D>;
+  using T = std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>;
+  constexpr uint32_t kMaxT = sizeof(T) == 1 ? 0xFF : 0x7FFF;  // also "no candidate yet"
+  const SgmRowGeometry& g = *a.g;
   const int dc = g.disparities, w = g.width;
+  // scratch: 4 horizontal path blocks, 2 pixels of sums, then the right-image minima.
   uint8_t* a0 = scratch;
   uint8_t* b0 = scratch + dc;
   uint8_t* a1 = scratch + 2 * dc;
   uint8_t* b1 = scratch + 3 * dc;
+  SumT* sums0 = reinterpret_cast<SumT*>(scratch + 4 * dc);
+  SumT* sums1 = sums0 + dc;
+  const int n_rev = g.rev_base + dc;
+  const size_t stride = (static_cast<size_t>(n_rev) + 64 + 31) & ~size_t{31};
+  T* minima = reinterpret_cast<T*>(scratch + 4 * dc + 2 * dc * sizeof(SumT) + 64);
+  RightMinima<T> rm;
+  for (int r = 0; r < 4; ++r) {
+    rm.min[r] = minima + 2 * r * stride;
+    rm.k[r] = rm.min[r] + stride;
+    std::fill(rm.min[r], rm.min[r] + n_rev, static_cast<T>(kMaxT));
+  }
   std::fill(a0, a0 + dc, uint8_t{0});  // paths enter the image from zero costs
   std::fill(a1, a1 + dc, uint8_t{0});
-  const V vp1 = hn::Set(d, p1);
   V m0 = hn::Zero(d), m1 = hn::Zero(d);
-  const auto p2 = [&](int x, int from) { return p2_table[std::abs(image_row[x] - image_row[from])]; };
-  const auto at = [dc](int x) { return static_cast<size_t>(x) * dc; };
+  const auto p2 = [&](int x, int from) { return a.p2_table[std::abs(a.image_row[x] - a.image_row[from])]; };
   int i = 0;
   for (; i < w / 2; ++i) {
     const int x0 = i, x1 = w - 1 - i;
-    const uint8_t p20 = p2(x0, i > 0 ? x0 - 1 : x0), p21 = p2(x1, i > 0 ? x1 + 1 : x1);
-    m0 = ChainStep<false, SumT>(d, dc, cost + at(x0), a0, b0, m0, vp1, p20, first + at(x0), va, vb, sum);
-    m1 = ChainStep<false, SumT>(d, dc, cost + at(x1), a1, b1, m1, vp1, p21, first + at(x1), va, vb, sum);
+    m0 = FirstVisit<kPlanes, SumT>(d, a, x0, a0, b0, m0, p2(x0, i > 0 ? x0 - 1 : x0));
+    m1 = FirstVisit<kPlanes, SumT>(d, a, x1, a1, b1, m1, p2(x1, i > 0 ? x1 + 1 : x1));
     std::swap(a0, b0);
     std::swap(a1, b1);
   }
   if (w % 2 == 1) {  // the middle pixel: left-to-right arrives first
     const int x = i;
-    const uint8_t p20 = p2(x, i > 0 ? x - 1 : x), p21 = p2(x, i > 0 ? x + 1 : x);
-    m0 = ChainStep<false, SumT>(d, dc, cost + at(x), a0, b0, m0, vp1, p20, first + at(x), va, vb, sum);
-    m1 = ChainStep<true, SumT>(d, dc, cost + at(x), a1, b1, m1, vp1, p21, first + at(x),
-                               va + at(x), vb + at(x), sum + at(x));
+    m0 = FirstVisit<kPlanes, SumT>(d, a, x, a0, b0, m0, p2(x, i > 0 ? x - 1 : x));
+    m1 = SecondVisit<kPlanes, SumT, false>(d, a, x, a1, b1, m1, p2(x, i > 0 ? x + 1 : x), sums1, rm);
     std::swap(a0, b0);
     std::swap(a1, b1);
     ++i;
   }
   for (; i < w; ++i) {
     const int x0 = i, x1 = w - 1 - i;
-    const uint8_t p20 = p2(x0, x0 - 1), p21 = p2(x1, x1 + 1);
-    m0 = ChainStep<true, SumT>(d, dc, cost + at(x0), a0, b0, m0, vp1, p20, first + at(x0),
-                               va + at(x0), vb + at(x0), sum + at(x0));
-    m1 = ChainStep<true, SumT>(d, dc, cost + at(x1), a1, b1, m1, vp1, p21, first + at(x1),
-                               va + at(x1), vb + at(x1), sum + at(x1));
+    m0 = SecondVisit<kPlanes, SumT, true>(d, a, x0, a0, b0, m0, p2(x0, x0 - 1), sums0, rm);
+    m1 = SecondVisit<kPlanes, SumT, false>(d, a, x1, a1, b1, m1, p2(x1, x1 + 1), sums1, rm);
     std::swap(a0, b0);
     std::swap(a1, b1);
   }
-}
-
-// Winner-take-all over a sum row of T (uint8_t, or int16_t holding the uint16 sums, which stay
-// below 2^15). Same results as WtaScalar.
-template <class T, class D>
-void WtaImpl(D d, const T* sum, const SgmRowGeometry& g, int uniqueness_percent, T* scratch,
-             int16_t* best, int16_t* right_best) {
-  using V = hn::Vec<D>;
-  constexpr uint32_t kMaxT = sizeof(T) == 1 ? 0xFF : 0x7FFF;  // also "no candidate yet"
-  const int n = static_cast<int>(hn::Lanes(d));
-  const int dc = g.disparities;
-  const int n_rev = g.rev_base + dc;
-  const size_t stride = static_cast<size_t>(n_rev) + 64;
-  // Right-image minima and their k, one copy per x mod kCopies: a pixel updates the copy that
-  // the pixel kCopies earlier wrote, long after those stores have left the store queue.
-  constexpr int kCopies = 4;
-  for (int r = 0; r < kCopies; ++r) {
-    std::fill(scratch + 2 * r * stride, scratch + 2 * r * stride + n_rev, static_cast<T>(kMaxT));
-  }
-  const V iota = hn::Iota(d, 0);
-  const V vn = hn::Set(d, static_cast<T>(n));
-  const uint32_t keep = static_cast<uint32_t>(100 - uniqueness_percent);
-  for (int x = 0; x < g.width; ++x) {
-    const T* s = sum + static_cast<size_t>(x) * dc;
-    V vmin = hn::Load(d, s);
-    for (int k = n; k < dc; k += n) vmin = hn::Min(vmin, hn::Load(d, s + k));
-    T m;
-    if constexpr (sizeof(T) == 1) {
-      m = hn::GetLane(MinAllU8(d, vmin));
-    } else {
-      m = hn::GetLane(hn::MinOfLanes(d, vmin));
-    }
-    const V vm = hn::Set(d, m);
-    int bk = 0;
-    for (int k = 0; k < dc; k += n) {
-      const intptr_t f = hn::FindFirstTrue(d, hn::Eq(hn::Load(d, s + k), vm));
-      if (f >= 0) {
-        bk = k + static_cast<int>(f);
-        break;
-      }
-    }
-    // Not unique iff a sum outside bk-1..bk+1 is below t = ceil(100 m / (100 - u)).
-    bool unique = true;
-    if (keep < 100 && m > 0) {
-      const uint32_t t = (static_cast<uint32_t>(m) * 100u + keep - 1) / keep;
-      size_t below = static_cast<size_t>(dc);
-      if (t <= kMaxT) {
-        below = 0;
-        const V vt1 = hn::Set(d, static_cast<T>(t - 1));
-        for (int k = 0; k < dc; k += n) {
-          const V v = hn::Load(d, s + k);
-          below += hn::CountTrue(d, hn::Eq(hn::Min(v, vt1), v));  // v <= t - 1
-        }
-      }
-      size_t near = 0;
-      for (int k = std::max(0, bk - 1); k <= std::min(dc - 1, bk + 1); ++k) {
-        near += static_cast<uint32_t>(s[k]) < t;
-      }
-      unique = below == near;
-    }
-    best[x] = static_cast<int16_t>(unique ? bk : -1 - bk);
-    T* rmin = scratch + 2 * static_cast<size_t>(x % kCopies) * stride + (g.rev_base - x);
-    T* rk = rmin + stride;
-    V kv = iota;
-    for (int k = 0; k < dc; k += n) {
-      const V v = hn::Load(d, s + k);
-      const V mo = hn::LoadU(d, rmin + k);
-      const V nm = hn::Min(v, mo);
-      hn::StoreU(hn::IfThenElse(hn::Eq(nm, mo), hn::LoadU(d, rk + k), kv), d, rk + k);  // v >= mo keeps
-      hn::StoreU(nm, d, rmin + k);
-      kv = hn::Add(kv, vn);
-    }
-  }
   // Merge the copies: the smaller sum wins, on a tie the smaller k (the golden model's first).
-  for (int xr = 0; xr < g.width; ++xr) {
-    const size_t i = static_cast<size_t>(g.rev_base - g.min_disparity - xr);
+  for (int xr = 0; xr < w; ++xr) {
+    const size_t i_rev = static_cast<size_t>(g.rev_base - g.min_disparity - xr);
     uint32_t bm = kMaxT;
     int bkk = -1;
-    for (int r = 0; r < kCopies; ++r) {
-      const T* cm = scratch + 2 * r * stride;
-      const uint32_t v = static_cast<uint32_t>(cm[i]);
+    for (int r = 0; r < 4; ++r) {
+      const uint32_t v = static_cast<uint32_t>(rm.min[r][i_rev]);
       if (v == kMaxT) continue;
-      const int kk = static_cast<int>(static_cast<std::make_unsigned_t<T>>(cm[stride + i]));
+      const int kk = static_cast<int>(static_cast<std::make_unsigned_t<T>>(rm.k[r][i_rev]));
       if (v < bm || (v == bm && kk < bkk)) {
         bm = v;
         bkk = kk;
@@ -357,18 +472,29 @@ static void FourPathVerticalSimd(const SgmCostRow& c, const SgmRowGeometry& g,
 #endif
 }
 
-static void FourPathHorizontalSimd(const uint8_t* cost, const uint8_t* image_row,
-                                   const SgmRowGeometry& g, const uint8_t* p2_table, uint8_t p1,
-                                   const uint8_t* va, const uint8_t* vb, uint8_t* first,
-                                   uint8_t* scratch, void* sum, bool narrow) {
+static void FourPathFinishRowSimd(const SgmCostRow& c, const SgmRowGeometry& g,
+                                  const uint8_t* image_row, const uint8_t* prev_image_row,
+                                  const uint8_t* p2_table, uint8_t p1, const uint8_t* prev,
+                                  const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
+                                  const uint8_t* vb, int uniqueness_percent, bool subpixel,
+                                  bool narrow, void* partial, uint8_t* scratch, int16_t* best,
+                                  int16_t* offset, int16_t* right_best) {
 #ifdef CAIRN_SGM_FOUR_PATH_KERNELS
+  RowArgs a{&c, &g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out, out_min, vb,
+            partial, uniqueness_percent, subpixel, best, offset};
   const auto run = [&](auto d) {
     if (narrow) {
-      HorizontalSumImpl<uint8_t>(d, cost, image_row, g, p2_table, p1, va, vb, first, scratch,
-                                 static_cast<uint8_t*>(sum));
+      if (c.planes == 3) {
+        FinishRowImpl<3, uint8_t>(d, a, scratch, right_best);
+      } else {
+        FinishRowImpl<0, uint8_t>(d, a, scratch, right_best);
+      }
     } else {
-      HorizontalSumImpl<uint16_t>(d, cost, image_row, g, p2_table, p1, va, vb, first, scratch,
-                                  static_cast<uint16_t*>(sum));
+      if (c.planes == 3) {
+        FinishRowImpl<3, uint16_t>(d, a, scratch, right_best);
+      } else {
+        FinishRowImpl<0, uint16_t>(d, a, scratch, right_best);
+      }
     }
   };
   const hn::CappedTag<uint8_t, 32> d32;
@@ -378,37 +504,9 @@ static void FourPathHorizontalSimd(const uint8_t* cost, const uint8_t* image_row
     run(hn::CappedTag<uint8_t, 16>());
   }
 #else
-  (void)cost, (void)image_row, (void)g, (void)p2_table, (void)p1, (void)va, (void)vb;
-  (void)first, (void)scratch, (void)sum, (void)narrow;
-#endif
-}
-
-static void FourPathWtaSimd(const void* sum, bool narrow, const SgmRowGeometry& g,
-                            int uniqueness_percent, void* scratch, int16_t* best,
-                            int16_t* right_best) {
-#ifdef CAIRN_SGM_FOUR_PATH_KERNELS
-  if (narrow) {
-    const hn::CappedTag<uint8_t, 32> d32;
-    if (g.disparities % static_cast<int>(hn::Lanes(d32)) == 0) {
-      WtaImpl(d32, static_cast<const uint8_t*>(sum), g, uniqueness_percent,
-              static_cast<uint8_t*>(scratch), best, right_best);
-    } else {
-      WtaImpl(hn::CappedTag<uint8_t, 16>(), static_cast<const uint8_t*>(sum), g,
-              uniqueness_percent, static_cast<uint8_t*>(scratch), best, right_best);
-    }
-  } else {
-    const hn::CappedTag<int16_t, 16> d16;
-    if (g.disparities % static_cast<int>(hn::Lanes(d16)) == 0) {
-      WtaImpl(d16, static_cast<const int16_t*>(sum), g, uniqueness_percent,
-              static_cast<int16_t*>(scratch), best, right_best);
-    } else {
-      WtaImpl(hn::CappedTag<int16_t, 8>(), static_cast<const int16_t*>(sum), g,
-              uniqueness_percent, static_cast<int16_t*>(scratch), best, right_best);
-    }
-  }
-#else
-  (void)sum, (void)narrow, (void)g, (void)uniqueness_percent, (void)scratch, (void)best;
-  (void)right_best;
+  (void)c, (void)g, (void)image_row, (void)prev_image_row, (void)p2_table, (void)p1, (void)prev;
+  (void)prev_min, (void)out, (void)out_min, (void)vb, (void)uniqueness_percent, (void)subpixel;
+  (void)narrow, (void)partial, (void)scratch, (void)best, (void)offset, (void)right_best;
 #endif
 }
 
@@ -422,8 +520,7 @@ namespace {
 
 HWY_EXPORT(HasFourPathSimd);
 HWY_EXPORT(FourPathVerticalSimd);
-HWY_EXPORT(FourPathHorizontalSimd);
-HWY_EXPORT(FourPathWtaSimd);
+HWY_EXPORT(FourPathFinishRowSimd);
 
 void Vertical(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
               const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
@@ -432,22 +529,22 @@ void Vertical(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image
   HWY_DYNAMIC_DISPATCH(FourPathVerticalSimd)(c, g, image_row, prev_image_row, p2_table, p1, prev,
                                              prev_min, out, out_min, cost_out);
 }
-void HorizontalSum(const uint8_t* cost, const uint8_t* image_row, const SgmRowGeometry& g,
-                   const uint8_t* p2_table, uint8_t p1, const uint8_t* va, const uint8_t* vb,
-                   uint8_t* first, uint8_t* scratch, void* sum, bool narrow) {
-  HWY_DYNAMIC_DISPATCH(FourPathHorizontalSimd)(cost, image_row, g, p2_table, p1, va, vb, first,
-                                               scratch, sum, narrow);
-}
-void Wta(const void* sum, bool narrow, const SgmRowGeometry& g, int uniqueness_percent,
-         void* scratch, int16_t* best, int16_t* right_best) {
-  HWY_DYNAMIC_DISPATCH(FourPathWtaSimd)(sum, narrow, g, uniqueness_percent, scratch, best,
-                                        right_best);
+void FinishRow(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
+               const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
+               const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
+               const uint8_t* vb,
+               int uniqueness_percent, bool subpixel, bool narrow, void* partial,
+               uint8_t* scratch, int16_t* best, int16_t* offset, int16_t* right_best) {
+  HWY_DYNAMIC_DISPATCH(FourPathFinishRowSimd)(c, g, image_row, prev_image_row, p2_table, p1, prev,
+                                              prev_min, out, out_min, vb, uniqueness_percent,
+                                              subpixel, narrow, partial, scratch, best, offset,
+                                              right_best);
 }
 
 }  // namespace
 
 const SgmFourPathKernels* SimdFourPathKernels() {
-  static const SgmFourPathKernels kernels{Vertical, HorizontalSum, Wta};
+  static const SgmFourPathKernels kernels{Vertical, FinishRow};
   return HWY_DYNAMIC_DISPATCH(HasFourPathSimd)() ? &kernels : nullptr;
 }
 
