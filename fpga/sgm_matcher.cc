@@ -153,12 +153,18 @@ SgmCostRow SgmMatcher::FourPathCostRow(FourPathLane& l, int y) {
   const uint8_t border_cost = static_cast<uint8_t>(options_.census_bits());
   uint8_t* nib = l.nibbles.get();
   uint8_t* border = l.border.get();
-  for (int i = 0; i < n_rev; ++i) {
-    const int xr = width_ - 1 + pad - i;
-    const bool inside = xr >= 0 && xr < width_;
-    const uint32_t c = inside ? cr[xr] : 0u;
-    for (int b = 0; b < planes; ++b) nib[b * stride + i] = static_cast<uint8_t>((c >> (4 * b)) & 15);
-    border[i] = inside ? 0 : border_cost;
+  // i = width - 1 + pad - xr: the right image sits at [pad, pad + width), zeros and the border
+  // cost around it.
+  const int in0 = pad, in1 = pad + width_;
+  std::fill(border, border + n_rev, border_cost);
+  std::fill(border + in0, border + in1, uint8_t{0});
+  for (int b = 0; b < planes; ++b) {
+    uint8_t* plane = nib + static_cast<ptrdiff_t>(b) * stride;
+    std::fill(plane, plane + in0, uint8_t{0});
+    std::fill(plane + in1, plane + n_rev, uint8_t{0});
+    const int shift = 4 * b;
+    const uint32_t* src = cr + (width_ - 1);
+    for (int i = in0; i < in1; ++i) plane[i] = static_cast<uint8_t>((src[in0 - i] >> shift) & 15);
   }
   SgmCostRow c;
   c.left = census_left_.get() + static_cast<size_t>(y) * width_;

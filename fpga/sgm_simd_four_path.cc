@@ -62,6 +62,16 @@ HWY_INLINE V After(D d, V v, V after) {
   }
 }
 
+// The disparity count, a compile-time constant where kNV (vectors per pixel) is given.
+template <int kNV, class D>
+HWY_INLINE int Disparities(D /*d*/, const SgmRowGeometry& g) {
+  if constexpr (kNV > 0) {
+    return kNV * static_cast<int>(hn::MaxLanes(D()));
+  } else {
+    return g.disparities;
+  }
+}
+
 // The minimum of the uint8 lanes of v, in every lane.
 template <class D, class V>
 HWY_INLINE V MinAllU8(D d, V v) {
@@ -80,14 +90,14 @@ HWY_INLINE V MinAllU8(D d, V v) {
 
 // One vertical path over a row with the cost computed on the fly (kPlanes nibble planes; 0: any
 // count, from c.planes).
-template <int kPlanes, class D>
+template <int kNV, int kPlanes, class D>
 void VerticalImpl(D d, const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
                   const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
                   const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
                   uint8_t* cost_out) {
   using V = hn::Vec<D>;
   const int n = static_cast<int>(hn::Lanes(d));
-  const int dc = g.disparities;
+  const int dc = Disparities<kNV>(d, g);
   const int planes = kPlanes > 0 ? kPlanes : c.planes;
   const V vp1 = hn::Set(d, p1);
   const V ff = hn::Set(d, uint8_t{0xFF});
@@ -108,6 +118,7 @@ void VerticalImpl(D d, const SgmCostRow& c, const SgmRowGeometry& g, const uint8
       jump = hn::SaturatedAdd(vmp, hn::Set(d, p2_table[std::abs(image_row[x] - prev_image_row[x])]));
     }
     V best = ff;
+#pragma GCC unroll 8
     for (int k = 0; k < dc; k += n) {
       V cost = hn::TableLookupBytes(tab[0], hn::LoadU(d, right + k));
       for (int b = 1; b < planes; ++b) {
@@ -176,14 +187,14 @@ HWY_INLINE hn::Vec<D> CostAt(D d, const SgmCostRow& c, const hn::Vec<D>* tab, co
 // The first of the two horizontal paths to reach pixel x: its cost, the own vertical path (prev
 // -> out), the horizontal step hprev -> hout (returns its minimum in every lane), and the
 // partial sum of these two and the opposite vertical path.
-template <int kPlanes, class SumT, class D>
+template <int kNV, int kPlanes, class SumT, class D>
 HWY_INLINE hn::Vec<D> FirstVisit(D d, const RowArgs& a, int x, const uint8_t* hprev, uint8_t* hout,
                                  hn::Vec<D> vmp, uint8_t p2h) {
   using V = hn::Vec<D>;
   const SgmCostRow& c = *a.c;
   const SgmRowGeometry& g = *a.g;
   const int n = static_cast<int>(hn::Lanes(d));
-  const int dc = g.disparities;
+  const int dc = Disparities<kNV>(d, g);
   const size_t at = static_cast<size_t>(x) * dc;
   V tab[8];
   CostTables<kPlanes>(d, c, x, tab);
@@ -201,6 +212,7 @@ HWY_INLINE hn::Vec<D> FirstVisit(D d, const RowArgs& a, int x, const uint8_t* hp
   const V jh = hn::SaturatedAdd(vmp, hn::Set(d, p2h));
   V best_v = ff, best_h = ff, before = ff;
   V pv = hn::Load(d, hprev);
+#pragma GCC unroll 8
   for (int k = 0; k < dc; k += n) {
     const V cost = CostAt<kPlanes>(d, c, tab, right, border, at_border, k);
     V ov = cost;
@@ -256,7 +268,7 @@ struct RightMinima {
 // The second of the two horizontal paths to reach pixel x: its step, the complete sum (into
 // `sums`, one pixel), winner-take-all with the uniqueness test, the sub-pixel offset and the
 // right-image minima.
-template <int kPlanes, class SumT, bool kAscending, class D>
+template <int kNV, int kPlanes, class SumT, bool kAscending, class D>
 HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* hprev,
                                   uint8_t* hout, hn::Vec<D> vmp, uint8_t p2h, SumT* sums,
                                   const RightMinima<std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>>& rm) {
@@ -265,7 +277,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
   const SgmCostRow& c = *a.c;
   const SgmRowGeometry& g = *a.g;
   const int n = static_cast<int>(hn::Lanes(d));
-  const int dc = g.disparities;
+  const int dc = Disparities<kNV>(d, g);
   const size_t at = static_cast<size_t>(x) * dc;
   V tab[8];
   CostTables<kPlanes>(d, c, x, tab);
@@ -277,6 +289,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
   const V jh = hn::SaturatedAdd(vmp, hn::Set(d, p2h));
   V best_h = ff, before = ff;
   V pv = hn::Load(d, hprev);
+#pragma GCC unroll 8
   for (int k = 0; k < dc; k += n) {
     const V cost = CostAt<kPlanes>(d, c, tab, right, border, at_border, k);
     const V after = k + n < dc ? hn::Load(d, hprev + k + n) : ff;
@@ -305,6 +318,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
   const int nt = static_cast<int>(hn::Lanes(dt));
   const T* s = reinterpret_cast<const T*>(sums);
   VT vmin = hn::Load(dt, s);
+#pragma GCC unroll 16
   for (int k = nt; k < dc; k += nt) vmin = hn::Min(vmin, hn::Load(dt, s + k));
   T m;
   if constexpr (sizeof(T) == 1) {
@@ -330,6 +344,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
     if (t <= kMaxT) {
       below = 0;
       const VT vt1 = hn::Set(dt, static_cast<T>(t - 1));
+#pragma GCC unroll 16
       for (int k = 0; k < dc; k += nt) {
         const VT v = hn::Load(dt, s + k);
         below += hn::CountTrue(dt, hn::Eq(hn::Min(v, vt1), v));  // v <= t - 1
@@ -351,6 +366,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
   T* rk = rm.k[copy] + (g.rev_base - x);
   VT kv = hn::Iota(dt, 0);
   const VT vn = hn::Set(dt, static_cast<T>(nt));
+#pragma GCC unroll 16
   for (int k = 0; k < dc; k += nt) {
     const VT v = hn::Load(dt, s + k);
     const VT mo = hn::LoadU(dt, rmin + k);
@@ -366,13 +382,13 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
 
 // A whole row of the second half; both horizontal directions advance in one loop (two
 // independent dependency chains, the per-pixel work of either fills the other's wait).
-template <int kPlanes, class SumT, class D>
+template <int kNV, int kPlanes, class SumT, class D>
 void FinishRowImpl(D d, const RowArgs& a, uint8_t* scratch, int16_t* right_best) {
   using V = hn::Vec<D>;
   using T = std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>;
   constexpr uint32_t kMaxT = sizeof(T) == 1 ? 0xFF : 0x7FFF;  // also "no candidate yet"
   const SgmRowGeometry& g = *a.g;
-  const int dc = g.disparities, w = g.width;
+  const int dc = Disparities<kNV>(d, g), w = g.width;
   // scratch: 4 horizontal path blocks, 2 pixels of sums, then the right-image minima.
   uint8_t* a0 = scratch;
   uint8_t* b0 = scratch + dc;
@@ -396,23 +412,23 @@ void FinishRowImpl(D d, const RowArgs& a, uint8_t* scratch, int16_t* right_best)
   int i = 0;
   for (; i < w / 2; ++i) {
     const int x0 = i, x1 = w - 1 - i;
-    m0 = FirstVisit<kPlanes, SumT>(d, a, x0, a0, b0, m0, p2(x0, i > 0 ? x0 - 1 : x0));
-    m1 = FirstVisit<kPlanes, SumT>(d, a, x1, a1, b1, m1, p2(x1, i > 0 ? x1 + 1 : x1));
+    m0 = FirstVisit<kNV, kPlanes, SumT>(d, a, x0, a0, b0, m0, p2(x0, i > 0 ? x0 - 1 : x0));
+    m1 = FirstVisit<kNV, kPlanes, SumT>(d, a, x1, a1, b1, m1, p2(x1, i > 0 ? x1 + 1 : x1));
     std::swap(a0, b0);
     std::swap(a1, b1);
   }
   if (w % 2 == 1) {  // the middle pixel: left-to-right arrives first
     const int x = i;
-    m0 = FirstVisit<kPlanes, SumT>(d, a, x, a0, b0, m0, p2(x, i > 0 ? x - 1 : x));
-    m1 = SecondVisit<kPlanes, SumT, false>(d, a, x, a1, b1, m1, p2(x, i > 0 ? x + 1 : x), sums1, rm);
+    m0 = FirstVisit<kNV, kPlanes, SumT>(d, a, x, a0, b0, m0, p2(x, i > 0 ? x - 1 : x));
+    m1 = SecondVisit<kNV, kPlanes, SumT, false>(d, a, x, a1, b1, m1, p2(x, i > 0 ? x + 1 : x), sums1, rm);
     std::swap(a0, b0);
     std::swap(a1, b1);
     ++i;
   }
   for (; i < w; ++i) {
     const int x0 = i, x1 = w - 1 - i;
-    m0 = SecondVisit<kPlanes, SumT, true>(d, a, x0, a0, b0, m0, p2(x0, x0 - 1), sums0, rm);
-    m1 = SecondVisit<kPlanes, SumT, false>(d, a, x1, a1, b1, m1, p2(x1, x1 + 1), sums1, rm);
+    m0 = SecondVisit<kNV, kPlanes, SumT, true>(d, a, x0, a0, b0, m0, p2(x0, x0 - 1), sums0, rm);
+    m1 = SecondVisit<kNV, kPlanes, SumT, false>(d, a, x1, a1, b1, m1, p2(x1, x1 + 1), sums1, rm);
     std::swap(a0, b0);
     std::swap(a1, b1);
   }
@@ -452,12 +468,16 @@ static void FourPathVerticalSimd(const SgmCostRow& c, const SgmRowGeometry& g,
                                  uint8_t* cost_out) {
 #ifdef CAIRN_SGM_FOUR_PATH_KERNELS
   const auto run = [&](auto d) {
-    if (c.planes == 3) {
-      VerticalImpl<3>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
-                      out_min, cost_out);
+    const bool four = g.disparities == 4 * static_cast<int>(hn::Lanes(d));
+    if (four && c.planes == 3) {
+      VerticalImpl<4, 3>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
+                         out_min, cost_out);
+    } else if (four) {
+      VerticalImpl<4, 0>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
+                         out_min, cost_out);
     } else {
-      VerticalImpl<0>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
-                      out_min, cost_out);
+      VerticalImpl<0, 0>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
+                         out_min, cost_out);
     }
   };
   const hn::CappedTag<uint8_t, 32> d32;
@@ -482,19 +502,20 @@ static void FourPathFinishRowSimd(const SgmCostRow& c, const SgmRowGeometry& g,
 #ifdef CAIRN_SGM_FOUR_PATH_KERNELS
   RowArgs a{&c, &g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out, out_min, vb,
             partial, uniqueness_percent, subpixel, best, offset};
+  // Vectors per pixel and nibble planes as compile-time constants for the common case (128
+  // disparities in 32-byte vectors or 64 in 16-byte ones, a 5x5 census).
   const auto run = [&](auto d) {
-    if (narrow) {
-      if (c.planes == 3) {
-        FinishRowImpl<3, uint8_t>(d, a, scratch, right_best);
+    const bool four = g.disparities == 4 * static_cast<int>(hn::Lanes(d));
+    if (four && c.planes == 3) {
+      if (narrow) {
+        FinishRowImpl<4, 3, uint8_t>(d, a, scratch, right_best);
       } else {
-        FinishRowImpl<0, uint8_t>(d, a, scratch, right_best);
+        FinishRowImpl<4, 3, uint16_t>(d, a, scratch, right_best);
       }
+    } else if (narrow) {
+      FinishRowImpl<0, 0, uint8_t>(d, a, scratch, right_best);
     } else {
-      if (c.planes == 3) {
-        FinishRowImpl<3, uint16_t>(d, a, scratch, right_best);
-      } else {
-        FinishRowImpl<0, uint16_t>(d, a, scratch, right_best);
-      }
+      FinishRowImpl<0, 0, uint16_t>(d, a, scratch, right_best);
     }
   };
   const hn::CappedTag<uint8_t, 32> d32;
