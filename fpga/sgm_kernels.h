@@ -107,14 +107,15 @@ struct SgmFourPathKernels {
   // vertical path vb, and winner-take-all as SgmKernels::wta (best, right_best); offset[x] is the
   // sub-pixel offset at best (SgmSubpixelOffset) with `subpixel` and 0 < best < D - 1, else 0.
   // Sums are uint8 when `narrow` (the caller guarantees that four path costs stay <= 255), else
-  // uint16. partial: width * D sums of scratch space; scratch: 4 D + 4 D + 64 bytes plus 8
-  // (rev_base + D + 96) sums.
+  // uint16. threshold[m] = ceil(100 m / (100 - uniqueness_percent)) for every sum m. partial:
+  // width * D sums and cost: width * D bytes of scratch space; scratch: 4 D + 4 D + 64 bytes
+  // plus 8 (rev_base + D + 96) sums.
   void (*finish_row)(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
                      const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
                      const uint8_t* prev, const uint8_t* prev_min, uint8_t* out,
                      uint8_t* out_min, const uint8_t* vb, int uniqueness_percent, bool subpixel,
-                     bool narrow, void* partial, uint8_t* scratch, int16_t* best,
-                     int16_t* offset, int16_t* right_best);
+                     bool narrow, void* partial, uint8_t* cost, const uint32_t* threshold,
+                     uint8_t* scratch, int16_t* best, int16_t* offset, int16_t* right_best);
 };
 // nullptr where the dispatched target has no such kernels (HWY_SCALAR).
 const SgmFourPathKernels* SimdFourPathKernels();

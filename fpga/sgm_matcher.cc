@@ -58,6 +58,12 @@ SgmMatcher::SgmMatcher(const SgmOptions& options)
   // Four path costs of at most census_bits + p2 each (sgm_kernels.h) fit uint8 sums; the winner's
   // index k has to fit them too.
   narrow_sums_ = 4 * (options.census_bits() + options.p2) <= 255 && options.num_disparities <= 256;
+  // The uniqueness test "s (100 - u) < m 100" as "s < t(m)" for every possible sum m <= 4 * 255.
+  const uint32_t keep = static_cast<uint32_t>(100 - options.uniqueness_percent);
+  uniqueness_threshold_.resize(4 * 255 + 1);
+  for (uint32_t m = 0; m < uniqueness_threshold_.size(); ++m) {
+    uniqueness_threshold_[m] = (m * 100u + keep - 1) / keep;
+  }
 }
 
 std::string_view SgmMatcher::name() const {
@@ -134,6 +140,7 @@ void SgmMatcher::AllocateFourPath() {
       l.mins[b] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
     }
     l.partial = AllocateBuffer<uint8_t>(row * 2, &buffer_bytes_);
+    l.cost = AllocateBuffer<uint8_t>(row, &buffer_bytes_);
     l.scratch = AllocateBuffer<uint8_t>(8 * d + 64 + 16 * (n_rev + 96), &buffer_bytes_);
     l.nibbles = AllocateBuffer<uint8_t>(planes * n_rev + 64, &buffer_bytes_);
     l.border = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
@@ -198,7 +205,8 @@ void SgmMatcher::FourPathFinish(FourPathLane& l, int y, uint8_t* out) {
                          l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
                          static_cast<uint8_t>(options_.p1), l.prev, l.prev_min, out, out_min,
                          VolumeRow(y), static_cast<int>(options_.uniqueness_percent),
-                         options_.subpixel, narrow_sums_, l.partial.get(), l.scratch.get(),
+                         options_.subpixel, narrow_sums_, l.partial.get(), l.cost.get(),
+                         uniqueness_threshold_.data(), l.scratch.get(),
                          l.best.get(), l.offset.get(), l.right_best.get());
   l.prev = out;
   l.prev_min = out_min;

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <string_view>
+#include <vector>
 
 #include <hwy/aligned_allocator.h>
 
@@ -70,7 +71,7 @@ class SgmMatcher final : public StereoMatcher {
   // vertical path, and finishes every row there: its own vertical path, both horizontal paths,
   // the sum (uint8 when four path costs cannot exceed 255), winner-take-all.
   struct FourPathLane {
-    Buffer<uint8_t> state[2], mins[2], partial, scratch, nibbles, border;
+    Buffer<uint8_t> state[2], mins[2], partial, cost, scratch, nibbles, border;
     Buffer<int16_t> best, offset, right_best;
     const uint8_t* prev = nullptr;  // the path row of the previous row of the sweep
     const uint8_t* prev_min = nullptr;
@@ -125,6 +126,7 @@ class SgmMatcher final : public StereoMatcher {
   Sweep sweeps_[2];
   const SgmFourPathKernels* four_path_ = nullptr;  // set: MatchFourPath is used
   bool narrow_sums_ = false;
+  std::vector<uint32_t> uniqueness_threshold_;  // SgmFourPathKernels::finish_row's threshold
   Buffer<uint8_t> volume_;
   FourPathLane lanes_[2];
   DisparityFilter filter_;

@@ -157,6 +157,8 @@ struct RowArgs {
   uint8_t* out_min;
   const uint8_t* vb;  // the opposite vertical path (volume row)
   void* partial;      // horizontal path of the first visit + both vertical paths, per pixel
+  uint8_t* cost;      // the cost row, from the first visit for the second
+  const uint32_t* threshold;  // ceil(100 m / (100 - uniqueness)) for every sum m
   int uniqueness_percent;
   bool subpixel;
   int16_t* best;
@@ -215,6 +217,7 @@ HWY_INLINE hn::Vec<D> FirstVisit(D d, const RowArgs& a, int x, const uint8_t* hp
 #pragma GCC unroll 8
   for (int k = 0; k < dc; k += n) {
     const V cost = CostAt<kPlanes>(d, c, tab, right, border, at_border, k);
+    hn::Store(cost, d, a.cost + at + k);
     V ov = cost;
     if (lp != nullptr) {
       V lm = hn::LoadU(d, lp + k - 1);
@@ -274,16 +277,10 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
                                   const RightMinima<std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>>& rm) {
   using V = hn::Vec<D>;
   using T = std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>;
-  const SgmCostRow& c = *a.c;
   const SgmRowGeometry& g = *a.g;
   const int n = static_cast<int>(hn::Lanes(d));
   const int dc = Disparities<kNV>(d, g);
   const size_t at = static_cast<size_t>(x) * dc;
-  V tab[8];
-  CostTables<kPlanes>(d, c, x, tab);
-  const uint8_t* right = c.nibbles + (g.rev_base - x);
-  const uint8_t* border = c.border + (g.rev_base - x);
-  const bool at_border = x < c.safe_begin || x >= c.safe_end;
   const V ff = hn::Set(d, uint8_t{0xFF});
   const V vp1 = hn::Set(d, a.p1);
   const V jh = hn::SaturatedAdd(vmp, hn::Set(d, p2h));
@@ -291,7 +288,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
   V pv = hn::Load(d, hprev);
 #pragma GCC unroll 8
   for (int k = 0; k < dc; k += n) {
-    const V cost = CostAt<kPlanes>(d, c, tab, right, border, at_border, k);
+    const V cost = hn::Load(d, a.cost + at + k);
     const V after = k + n < dc ? hn::Load(d, hprev + k + n) : ff;
     const V m = hn::Min(hn::Min(pv, jh),
                         hn::SaturatedAdd(hn::Min(Before(d, pv, before), After(d, pv, after)), vp1));
@@ -336,10 +333,9 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
     }
   }
   // Not unique iff a sum outside bk-1..bk+1 is below t = ceil(100 m / (100 - u)).
-  const uint32_t keep = static_cast<uint32_t>(100 - a.uniqueness_percent);
   bool unique = true;
-  if (keep < 100 && m > 0) {
-    const uint32_t t = (static_cast<uint32_t>(m) * 100u + keep - 1) / keep;
+  if (a.uniqueness_percent > 0 && m > 0) {
+    const uint32_t t = a.threshold[m];
     size_t below = static_cast<size_t>(dc);
     if (t <= kMaxT) {
       below = 0;
@@ -357,9 +353,9 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
     unique = below == near;
   }
   a.best[x] = static_cast<int16_t>(unique ? bk : -1 - bk);
-  a.offset[x] = static_cast<int16_t>(a.subpixel && bk > 0 && bk < dc - 1
+  a.offset[x] = static_cast<int16_t>(unique && a.subpixel && bk > 0 && bk < dc - 1
                                          ? SgmSubpixelOffset(s[bk - 1], s[bk], s[bk + 1])
-                                         : 0);
+                                         : 0);  // (not needed where the pixel is not unique)
   // The right-image minima over the diagonal of x.
   const int copy = (kAscending ? 0 : 2) + (x & 1);
   T* rmin = rm.min[copy] + (g.rev_base - x);
@@ -497,11 +493,12 @@ static void FourPathFinishRowSimd(const SgmCostRow& c, const SgmRowGeometry& g,
                                   const uint8_t* p2_table, uint8_t p1, const uint8_t* prev,
                                   const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
                                   const uint8_t* vb, int uniqueness_percent, bool subpixel,
-                                  bool narrow, void* partial, uint8_t* scratch, int16_t* best,
+                                  bool narrow, void* partial, uint8_t* cost,
+                                  const uint32_t* threshold, uint8_t* scratch, int16_t* best,
                                   int16_t* offset, int16_t* right_best) {
 #ifdef CAIRN_SGM_FOUR_PATH_KERNELS
   RowArgs a{&c, &g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out, out_min, vb,
-            partial, uniqueness_percent, subpixel, best, offset};
+            partial, cost, threshold, uniqueness_percent, subpixel, best, offset};
   // Vectors per pixel and nibble planes as compile-time constants for the common case (128
   // disparities in 32-byte vectors or 64 in 16-byte ones, a 5x5 census).
   const auto run = [&](auto d) {
@@ -527,7 +524,8 @@ static void FourPathFinishRowSimd(const SgmCostRow& c, const SgmRowGeometry& g,
 #else
   (void)c, (void)g, (void)image_row, (void)prev_image_row, (void)p2_table, (void)p1, (void)prev;
   (void)prev_min, (void)out, (void)out_min, (void)vb, (void)uniqueness_percent, (void)subpixel;
-  (void)narrow, (void)partial, (void)scratch, (void)best, (void)offset, (void)right_best;
+  (void)narrow, (void)partial, (void)cost, (void)threshold, (void)scratch, (void)best;
+  (void)offset, (void)right_best;
 #endif
 }
 
@@ -555,11 +553,12 @@ void FinishRow(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* imag
                const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
                const uint8_t* vb,
                int uniqueness_percent, bool subpixel, bool narrow, void* partial,
-               uint8_t* scratch, int16_t* best, int16_t* offset, int16_t* right_best) {
+               uint8_t* cost, const uint32_t* threshold, uint8_t* scratch, int16_t* best,
+               int16_t* offset, int16_t* right_best) {
   HWY_DYNAMIC_DISPATCH(FourPathFinishRowSimd)(c, g, image_row, prev_image_row, p2_table, p1, prev,
                                               prev_min, out, out_min, vb, uniqueness_percent,
-                                              subpixel, narrow, partial, scratch, best, offset,
-                                              right_best);
+                                              subpixel, narrow, partial, cost, threshold,
+                                              scratch, best, offset, right_best);
 }
 
 }  // namespace
