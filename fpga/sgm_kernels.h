@@ -14,6 +14,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "fpga/stereo_matcher_interface.h"
+
 namespace cairn {
 
 inline constexpr uint8_t kPathSentinel = 0xFF;
@@ -71,7 +73,12 @@ uint8_t SgmPathStep(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uin
                     uint8_t p2, int d_count, uint8_t* out);
 // Equiangular sub-pixel offset in 1/kDisparityScale px from the sums at the winner (`at`) and its
 // neighbours, rounded half away from zero; 0 when the denominator is 0.
-int SgmSubpixelOffset(int below, int at, int above);
+inline int SgmSubpixelOffset(int below, int at, int above) {
+  const int den = (below > above ? below : above) - at;
+  if (den <= 0) return 0;
+  const int num = (below - above) * (kDisparityScale / 2);
+  return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
 // The left-right check of a left winner k against the right image's winner at the match (-1 when
 // that right pixel had no candidate).
 inline bool SgmLeftRightConsistent(int k, int right_k, int max_diff) {

@@ -91,10 +91,14 @@ HWY_INLINE V MinAllU8(D d, V v) {
 // One vertical path over a row with the cost computed on the fly (kPlanes nibble planes; 0: any
 // count, from c.planes).
 template <int kNV, int kPlanes, class D>
-void VerticalImpl(D d, const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
-                  const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
-                  const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
-                  uint8_t* cost_out) {
+void VerticalImpl(D d, const SgmCostRow& c_in, const SgmRowGeometry& g_in,
+                  const uint8_t* image_row, const uint8_t* prev_image_row,
+                  const uint8_t* p2_table, uint8_t p1, const uint8_t* prev,
+                  const uint8_t* prev_min, uint8_t* out, uint8_t* out_min, uint8_t* cost_out) {
+  // Local copies: byte stores may alias anything the compiler cannot see is local, which would
+  // reload every field after every store.
+  const SgmCostRow c = c_in;
+  const SgmRowGeometry g = g_in;
   using V = hn::Vec<D>;
   const int n = static_cast<int>(hn::Lanes(d));
   const int dc = Disparities<kNV>(d, g);
@@ -324,13 +328,13 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
     m = hn::GetLane(hn::MinOfLanes(dt, vmin));
   }
   const VT vm = hn::Set(dt, m);
+  // The first k with the minimum: the chunks from the last to the first, without branches (where
+  // the minimum lies is data, so an early exit mispredicts).
   int bk = 0;
-  for (int k = 0; k < dc; k += nt) {
+#pragma GCC unroll 16
+  for (int k = dc - nt; k >= 0; k -= nt) {
     const intptr_t f = hn::FindFirstTrue(dt, hn::Eq(hn::Load(dt, s + k), vm));
-    if (f >= 0) {
-      bk = k + static_cast<int>(f);
-      break;
-    }
+    bk = f >= 0 ? k + static_cast<int>(f) : bk;
   }
   // Not unique iff a sum outside bk-1..bk+1 is below t = ceil(100 m / (100 - u)).
   bool unique = true;
@@ -346,10 +350,10 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
         below += hn::CountTrue(dt, hn::Eq(hn::Min(v, vt1), v));  // v <= t - 1
       }
     }
-    size_t near = 0;
-    for (int k = std::max(0, bk - 1); k <= std::min(dc - 1, bk + 1); ++k) {
-      near += static_cast<uint32_t>(s[k]) < t;
-    }
+    // s[-1] and s[dc] are readable (scratch around the sums).
+    const size_t near = size_t{static_cast<uint32_t>(s[bk]) < t} +
+                        size_t{(bk > 0) & (static_cast<uint32_t>(s[bk - 1]) < t)} +
+                        size_t{(bk + 1 < dc) & (static_cast<uint32_t>(s[bk + 1]) < t)};
     unique = below == near;
   }
   a.best[x] = static_cast<int16_t>(unique ? bk : -1 - bk);
@@ -379,7 +383,14 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
 // A whole row of the second half; both horizontal directions advance in one loop (two
 // independent dependency chains, the per-pixel work of either fills the other's wait).
 template <int kNV, int kPlanes, class SumT, class D>
-void FinishRowImpl(D d, const RowArgs& a, uint8_t* scratch, int16_t* right_best) {
+void FinishRowImpl(D d, const RowArgs& args, uint8_t* scratch, int16_t* right_best) {
+  // Local copies: byte stores may alias anything the compiler cannot see is local, which would
+  // reload every field after every store.
+  const SgmCostRow c_local = *args.c;
+  const SgmRowGeometry g_local = *args.g;
+  RowArgs a = args;
+  a.c = &c_local;
+  a.g = &g_local;
   using V = hn::Vec<D>;
   using T = std::conditional_t<sizeof(SumT) == 1, uint8_t, int16_t>;
   constexpr uint32_t kMaxT = sizeof(T) == 1 ? 0xFF : 0x7FFF;  // also "no candidate yet"
