@@ -123,6 +123,11 @@ struct SgmFourPathKernels {
                      uint8_t* out_min, const uint8_t* vb, int uniqueness_percent, bool subpixel,
                      bool narrow, void* partial, uint8_t* cost, const uint32_t* threshold,
                      uint8_t* scratch, int16_t* best, int16_t* offset, int16_t* right_best);
+  // The nibble planes of SgmCostRow from one row of right census: plane b at out + b * stride,
+  // index i = width - 1 + pad - xr for xr in [0, width) (pad = max(0, -d_min)), 0 elsewhere
+  // below n_rev = rev_base + D.
+  void (*nibbles)(const uint32_t* census, int width, int planes, int pad, int n_rev, uint8_t* out,
+                  int stride);
 };
 // nullptr where the dispatched target has no such kernels (HWY_SCALAR).
 const SgmFourPathKernels* SimdFourPathKernels();

@@ -133,7 +133,15 @@ void SgmMatcher::AllocateFourPath() {
   volume_ = AllocateBuffer<uint8_t>(row * h + 128, &buffer_bytes_);
   AdviseHugePages(volume_.get(), row * h + 128);
   const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
-  const size_t planes = (static_cast<size_t>(options_.census_bits()) + 3) / 4;
+  const size_t planes = static_cast<size_t>(nibble_planes());
+  nibbles_ = AllocateBuffer<uint8_t>(h * planes * static_cast<size_t>(nibble_stride()) + 64,
+                                     &buffer_bytes_);
+  // The right image sits at i in [pad, pad + width) (pad = max(0, -d_min)), the border cost
+  // around it.
+  border_ = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
+  const int pad = geometry_.rev_base - (width_ - 1) - geometry_.min_disparity;
+  std::fill_n(border_.get(), n_rev, static_cast<uint8_t>(options_.census_bits()));
+  std::fill_n(border_.get() + pad, w, uint8_t{0});
   for (FourPathLane& l : lanes_) {
     for (int b = 0; b < 2; ++b) {
       l.state[b] = AllocateBuffer<uint8_t>(row + 128, &buffer_bytes_);
@@ -142,43 +150,20 @@ void SgmMatcher::AllocateFourPath() {
     l.partial = AllocateBuffer<uint8_t>(row * 2, &buffer_bytes_);
     l.cost = AllocateBuffer<uint8_t>(row, &buffer_bytes_);
     l.scratch = AllocateBuffer<uint8_t>(8 * d + 64 + 16 * (n_rev + 96), &buffer_bytes_);
-    l.nibbles = AllocateBuffer<uint8_t>(planes * n_rev + 64, &buffer_bytes_);
-    l.border = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
     l.best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
     l.offset = AllocateBuffer<int16_t>(w, &buffer_bytes_);
     l.right_best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
   }
 }
 
-SgmCostRow SgmMatcher::FourPathCostRow(FourPathLane& l, int y) {
+SgmCostRow SgmMatcher::FourPathCostRow(int y) const {
   const SgmRowGeometry& g = geometry_;
-  const int n_rev = g.rev_base + g.disparities;
-  const int stride = n_rev + 64;  // as allocated
-  const int planes = (options_.census_bits() + 3) / 4;
-  const int pad = g.rev_base - (width_ - 1) - g.min_disparity;  // = max(0, -d_min)
-  const uint32_t* cr = census_right_.get() + static_cast<size_t>(y) * width_;
-  const uint8_t border_cost = static_cast<uint8_t>(options_.census_bits());
-  uint8_t* nib = l.nibbles.get();
-  uint8_t* border = l.border.get();
-  // i = width - 1 + pad - xr: the right image sits at [pad, pad + width), zeros and the border
-  // cost around it.
-  const int in0 = pad, in1 = pad + width_;
-  std::fill(border, border + n_rev, border_cost);
-  std::fill(border + in0, border + in1, uint8_t{0});
-  for (int b = 0; b < planes; ++b) {
-    uint8_t* plane = nib + static_cast<ptrdiff_t>(b) * stride;
-    std::fill(plane, plane + in0, uint8_t{0});
-    std::fill(plane + in1, plane + n_rev, uint8_t{0});
-    const int shift = 4 * b;
-    const uint32_t* src = cr + (width_ - 1);
-    for (int i = in0; i < in1; ++i) plane[i] = static_cast<uint8_t>((src[in0 - i] >> shift) & 15);
-  }
   SgmCostRow c;
   c.left = census_left_.get() + static_cast<size_t>(y) * width_;
-  c.nibbles = nib;
-  c.stride = stride;
-  c.planes = planes;
-  c.border = border;
+  c.stride = nibble_stride();
+  c.planes = nibble_planes();
+  c.nibbles = nibbles_.get() + static_cast<size_t>(y) * c.planes * c.stride;
+  c.border = border_.get();
   // x - d_min - k is inside the right image for every k.
   c.safe_begin = std::max(0, g.min_disparity + g.disparities - 1);
   c.safe_end = std::min(width_, width_ + g.min_disparity);
@@ -186,7 +171,7 @@ SgmCostRow SgmMatcher::FourPathCostRow(FourPathLane& l, int y) {
 }
 
 void SgmMatcher::FourPathVertical(FourPathLane& l, int y, uint8_t* out) {
-  const SgmCostRow c = FourPathCostRow(l, y);
+  const SgmCostRow c = FourPathCostRow(y);
   uint8_t* out_min = l.mins[l.cur_min].get();
   four_path_->vertical(c, geometry_, image_row(y),
                        l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
@@ -199,7 +184,7 @@ void SgmMatcher::FourPathVertical(FourPathLane& l, int y, uint8_t* out) {
 }
 
 void SgmMatcher::FourPathFinish(FourPathLane& l, int y, uint8_t* out) {
-  const SgmCostRow c = FourPathCostRow(l, y);
+  const SgmCostRow c = FourPathCostRow(y);
   uint8_t* out_min = l.mins[l.cur_min].get();
   four_path_->finish_row(c, geometry_, image_row(y),
                          l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
@@ -445,6 +430,13 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
                        static_cast<int>(options_.census_height), census_left_.get() + static_cast<size_t>(y) * w);
       kernels_->census(pad_right_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
                        static_cast<int>(options_.census_height), census_right_.get() + static_cast<size_t>(y) * w);
+      if (four_path_ != nullptr) {
+        const int planes = nibble_planes(), stride = nibble_stride();
+        four_path_->nibbles(census_right_.get() + static_cast<size_t>(y) * w, w, planes,
+                            geometry_.rev_base - (w - 1) - geometry_.min_disparity,
+                            geometry_.rev_base + geometry_.disparities,
+                            nibbles_.get() + static_cast<size_t>(y) * planes * stride, stride);
+      }
     }
   });
 

@@ -71,7 +71,7 @@ class SgmMatcher final : public StereoMatcher {
   // vertical path, and finishes every row there: its own vertical path, both horizontal paths,
   // the sum (uint8 when four path costs cannot exceed 255), winner-take-all.
   struct FourPathLane {
-    Buffer<uint8_t> state[2], mins[2], partial, cost, scratch, nibbles, border;
+    Buffer<uint8_t> state[2], mins[2], partial, cost, scratch;
     Buffer<int16_t> best, offset, right_best;
     const uint8_t* prev = nullptr;  // the path row of the previous row of the sweep
     const uint8_t* prev_min = nullptr;
@@ -80,8 +80,10 @@ class SgmMatcher final : public StereoMatcher {
   };
   void AllocateFourPath();
   void MatchFourPath();
-  // The cost inputs of row y (SgmCostRow) from the lane's buffers.
-  SgmCostRow FourPathCostRow(FourPathLane& l, int y);
+  // The cost inputs of row y (SgmCostRow).
+  SgmCostRow FourPathCostRow(int y) const;
+  int nibble_planes() const { return (options_.census_bits() + 3) / 4; }
+  int nibble_stride() const { return geometry_.rev_base + geometry_.disparities + 64; }
   // Continues the lane's sweep with row y: only the vertical path (first half), or the whole row.
   void FourPathVertical(FourPathLane& l, int y, uint8_t* out);
   void FourPathFinish(FourPathLane& l, int y, uint8_t* out);
@@ -128,6 +130,7 @@ class SgmMatcher final : public StereoMatcher {
   bool narrow_sums_ = false;
   std::vector<uint32_t> uniqueness_threshold_;  // SgmFourPathKernels::finish_row's threshold
   Buffer<uint8_t> volume_;
+  Buffer<uint8_t> nibbles_, border_;  // SgmCostRow's right census planes (every row), border
   FourPathLane lanes_[2];
   DisparityFilter filter_;
   size_t buffer_bytes_ = 0;

@@ -459,6 +459,33 @@ void FinishRowImpl(D d, const RowArgs& args, uint8_t* scratch, int16_t* right_be
 
 #endif  // HWY_TARGET != HWY_SCALAR && !HWY_HAVE_SCALABLE
 
+// Reversed right census of one row as nibble planes (SgmCostRow): plane b at out + b * stride,
+// index i = width - 1 + pad - xr, zeros outside [pad, pad + width) up to n_rev.
+static void FourPathNibblesSimd(const uint32_t* census, int width, int planes, int pad,
+                                int n_rev, uint8_t* out, int stride) {
+  const hn::CappedTag<int32_t, 8> di;
+  const hn::Rebind<uint8_t, decltype(di)> d8;
+  const int n = static_cast<int>(hn::Lanes(di));
+  const int32_t* src = reinterpret_cast<const int32_t*>(census);
+  for (int b = 0; b < planes; ++b) {
+    uint8_t* plane = out + static_cast<ptrdiff_t>(b) * stride;
+    std::fill(plane, plane + pad, uint8_t{0});
+    std::fill(plane + pad + width, plane + n_rev, uint8_t{0});
+    const int shift = 4 * b;
+    const auto mask = hn::Set(di, 15);
+    int xr = 0;
+    for (; xr + n <= width; xr += n) {
+      // Logical shift: the census has at most 32 bits, the mask drops what an arithmetic one
+      // would shift in.
+      const auto v = hn::And(hn::ShiftRightSame(hn::LoadU(di, src + xr), shift), mask);
+      hn::StoreU(hn::DemoteTo(d8, hn::Reverse(di, v)), d8, plane + (width + pad - xr - n));
+    }
+    for (; xr < width; ++xr) {
+      plane[width - 1 + pad - xr] = static_cast<uint8_t>((census[xr] >> shift) & 15);
+    }
+  }
+}
+
 static bool HasFourPathSimd() {
 #ifdef CAIRN_SGM_FOUR_PATH_KERNELS
   return true;
@@ -551,6 +578,7 @@ namespace {
 HWY_EXPORT(HasFourPathSimd);
 HWY_EXPORT(FourPathVerticalSimd);
 HWY_EXPORT(FourPathFinishRowSimd);
+HWY_EXPORT(FourPathNibblesSimd);
 
 void Vertical(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
               const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
@@ -572,10 +600,15 @@ void FinishRow(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* imag
                                               scratch, best, offset, right_best);
 }
 
+void Nibbles(const uint32_t* census, int width, int planes, int pad, int n_rev, uint8_t* out,
+             int stride) {
+  HWY_DYNAMIC_DISPATCH(FourPathNibblesSimd)(census, width, planes, pad, n_rev, out, stride);
+}
+
 }  // namespace
 
 const SgmFourPathKernels* SimdFourPathKernels() {
-  static const SgmFourPathKernels kernels{Vertical, FinishRow};
+  static const SgmFourPathKernels kernels{Vertical, FinishRow, Nibbles};
   return HWY_DYNAMIC_DISPATCH(HasFourPathSimd)() ? &kernels : nullptr;
 }
 
