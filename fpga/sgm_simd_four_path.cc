@@ -88,6 +88,27 @@ HWY_INLINE V MinAllU8(D d, V v) {
   return hn::Min(v, hn::TableLookupBytes(v, hn::LoadDup128(d, kSwap1)));
 }
 
+// The minimum of the uint8 lanes of v as a number (x86: phminposuw on 16-bit pairs).
+template <class D, class V>
+HWY_INLINE uint8_t MinU8(D d, V v) {
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_SSE4
+  const hn::Full128<uint8_t> d16;
+  hn::Vec128<uint8_t> x;
+  if constexpr (hn::MaxLanes(D()) == 32) {
+    x = hn::Min(hn::LowerHalf(v), hn::UpperHalf(hn::Half<D>(), v));
+  } else {
+    x = v;
+  }
+  const hn::Full128<uint16_t> dw;
+  const auto w = hn::BitCast(dw, x);
+  const auto m = hn::Min(hn::And(w, hn::Set(dw, uint16_t{0xFF})), hn::ShiftRight<8>(w));
+  (void)d16;
+  return static_cast<uint8_t>(hn::GetLane(hn::MinOfLanes(dw, m)));
+#else
+  return hn::GetLane(MinAllU8(d, v));
+#endif
+}
+
 // One vertical path over a row with the cost computed on the fly (kPlanes nibble planes; 0: any
 // count, from c.planes).
 template <int kNV, int kPlanes, class D>
@@ -143,7 +164,7 @@ void VerticalImpl(D d, const SgmCostRow& c_in, const SgmRowGeometry& g_in,
       hn::Store(o, d, o_row + k);
       best = hn::Min(best, o);
     }
-    out_min[x] = hn::GetLane(MinAllU8(d, best));
+    out_min[x] = MinU8(d, best);
   }
 }
 
@@ -259,7 +280,7 @@ HWY_INLINE hn::Vec<D> FirstVisit(D d, const RowArgs& a, int x, const uint8_t* hp
     before = pv;
     pv = after;
   }
-  a.out_min[x] = hn::GetLane(MinAllU8(d, best_v));
+  a.out_min[x] = MinU8(d, best_v);
   return MinAllU8(d, best_h);
 }
 
@@ -323,7 +344,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
   for (int k = nt; k < dc; k += nt) vmin = hn::Min(vmin, hn::Load(dt, s + k));
   T m;
   if constexpr (sizeof(T) == 1) {
-    m = hn::GetLane(MinAllU8(dt, vmin));
+    m = MinU8(dt, vmin);
   } else {
     m = hn::GetLane(hn::MinOfLanes(dt, vmin));
   }
