@@ -87,11 +87,13 @@ inline bool SgmLeftRightConsistent(int k, int right_k, int max_diff) {
 // The SIMD backend's own schedule for the four horizontal and vertical paths
 // (SgmMatcher::MatchFourPath): fewer, fused passes, the same arithmetic as the kernels above.
 //
-// Cost inputs of one row. The reversed right census is stored as `planes` = ceil(census bits / 4)
-// nibble planes: nibble b of right(i) is nibbles[b * stride + i]. cost(x, k) is as in
+// Cost inputs of one row. Both census rows are stored as `planes` = ceil(census bits / 4) nibble
+// planes: nibble b of the left census at x is left[b * left_stride + x], nibble b of the reversed
+// right census right(i) (see SgmKernels::cost) is nibbles[b * stride + i]. cost(x, k) is as in
 // SgmKernels::cost; pixels x in [safe_begin, safe_end) have no border lanes.
 struct SgmCostRow {
-  const uint32_t* left = nullptr;
+  const uint8_t* left = nullptr;
+  int left_stride = 0;
   const uint8_t* nibbles = nullptr;
   int stride = 0;
   int planes = 0;
@@ -123,11 +125,11 @@ struct SgmFourPathKernels {
                      uint8_t* out_min, const uint8_t* vb, int uniqueness_percent, bool subpixel,
                      bool narrow, void* partial, uint8_t* cost, const uint32_t* threshold,
                      uint8_t* scratch, int16_t* best, int16_t* offset, int16_t* right_best);
-  // The nibble planes of SgmCostRow from one row of right census: plane b at out + b * stride,
-  // index i = width - 1 + pad - xr for xr in [0, width) (pad = max(0, -d_min)), 0 elsewhere
+  // SgmKernels::census of one row, as SgmCostRow's nibble planes: plane b at out + b * stride,
+  // index x, or with `reversed` index width - 1 + pad - x (pad = max(0, -d_min)) and 0 elsewhere
   // below n_rev = rev_base + D.
-  void (*nibbles)(const uint32_t* census, int width, int planes, int pad, int n_rev, uint8_t* out,
-                  int stride);
+  void (*census)(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch, uint8_t* out,
+                 int plane_stride, bool reversed, int pad, int n_rev);
 };
 // nullptr where the dispatched target has no such kernels (HWY_SCALAR).
 const SgmFourPathKernels* SimdFourPathKernels();

@@ -92,8 +92,10 @@ void SgmMatcher::Allocate(int width, int height) {
   pad_right_ = AllocateBuffer<uint8_t>(pad_bytes, &buffer_bytes_);
   std::memset(pad_left_.get(), 0, pad_bytes);
   std::memset(pad_right_.get(), 0, pad_bytes);
-  census_left_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
-  census_right_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+  if (four_path_ == nullptr) {  // the four-path schedule keeps its census as nibble planes
+    census_left_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+    census_right_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+  }
   if (four_path_ != nullptr) {
     AllocateFourPath();
   } else if (!options_.raster_paths) {  // the raster pass needs no sum volume
@@ -136,6 +138,7 @@ void SgmMatcher::AllocateFourPath() {
   const size_t planes = static_cast<size_t>(nibble_planes());
   nibbles_ = AllocateBuffer<uint8_t>(h * planes * static_cast<size_t>(nibble_stride()) + 64,
                                      &buffer_bytes_);
+  left_nibbles_ = AllocateBuffer<uint8_t>(h * planes * w + 64, &buffer_bytes_);
   // The right image sits at i in [pad, pad + width) (pad = max(0, -d_min)), the border cost
   // around it.
   border_ = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
@@ -159,9 +162,10 @@ void SgmMatcher::AllocateFourPath() {
 SgmCostRow SgmMatcher::FourPathCostRow(int y) const {
   const SgmRowGeometry& g = geometry_;
   SgmCostRow c;
-  c.left = census_left_.get() + static_cast<size_t>(y) * width_;
   c.stride = nibble_stride();
   c.planes = nibble_planes();
+  c.left_stride = width_;
+  c.left = left_nibbles_.get() + static_cast<size_t>(y) * c.planes * width_;
   c.nibbles = nibbles_.get() + static_cast<size_t>(y) * c.planes * c.stride;
   c.border = border_.get();
   // x - d_min - k is inside the right image for every k.
@@ -426,17 +430,23 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
     band(t, h, &y0, &y1);
     for (int y = y0; y < y1; ++y) {
       const ptrdiff_t off = (y + ry_) * pad_stride_ + rx_;
+      if (four_path_ != nullptr) {  // the census as the four-path kernels read it
+        const int cw = static_cast<int>(options_.census_width);
+        const int ch = static_cast<int>(options_.census_height);
+        const int planes = nibble_planes(), stride = nibble_stride();
+        four_path_->census(pad_left_.get() + off, pad_stride_, w, cw, ch,
+                           left_nibbles_.get() + static_cast<size_t>(y) * planes * w, w, false, 0,
+                           w);
+        four_path_->census(pad_right_.get() + off, pad_stride_, w, cw, ch,
+                           nibbles_.get() + static_cast<size_t>(y) * planes * stride, stride, true,
+                           geometry_.rev_base - (w - 1) - geometry_.min_disparity,
+                           geometry_.rev_base + geometry_.disparities);
+        continue;
+      }
       kernels_->census(pad_left_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
                        static_cast<int>(options_.census_height), census_left_.get() + static_cast<size_t>(y) * w);
       kernels_->census(pad_right_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
                        static_cast<int>(options_.census_height), census_right_.get() + static_cast<size_t>(y) * w);
-      if (four_path_ != nullptr) {
-        const int planes = nibble_planes(), stride = nibble_stride();
-        four_path_->nibbles(census_right_.get() + static_cast<size_t>(y) * w, w, planes,
-                            geometry_.rev_base - (w - 1) - geometry_.min_disparity,
-                            geometry_.rev_base + geometry_.disparities,
-                            nibbles_.get() + static_cast<size_t>(y) * planes * stride, stride);
-      }
     }
   });
 

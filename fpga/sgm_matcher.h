@@ -130,7 +130,8 @@ class SgmMatcher final : public StereoMatcher {
   bool narrow_sums_ = false;
   std::vector<uint32_t> uniqueness_threshold_;  // SgmFourPathKernels::finish_row's threshold
   Buffer<uint8_t> volume_;
-  Buffer<uint8_t> nibbles_, border_;  // SgmCostRow's right census planes (every row), border
+  // SgmCostRow's census nibble planes of every row (left, reversed right) and border costs.
+  Buffer<uint8_t> left_nibbles_, nibbles_, border_;
   FourPathLane lanes_[2];
   DisparityFilter filter_;
   size_t buffer_bytes_ = 0;

@@ -2,8 +2,9 @@
 // (SgmFourPathKernels in sgm_kernels.h; SgmMatcher::MatchFourPath runs them). The arithmetic is
 // the golden model's (sgm_scalar_kernels.cc) lane for lane; only the order of the work and the
 // memory it touches differ:
-// - the cost of a pixel is computed where the first path consumes it, from nibble lookup tables
-//   (popcount(l ^ r) = sum over nibbles of T[l nibble][r nibble], one byte shuffle per nibble);
+// - the census is computed 32 pixels at a time straight into nibble planes, and the cost of a
+//   pixel where the first path consumes it, from nibble lookup tables (popcount(l ^ r) = sum
+//   over nibbles of T[l nibble][r nibble], one byte shuffle per nibble);
 // - a path step of the horizontal recursions keeps its neighbours in registers (byte shifts
 //   across vectors instead of unaligned reloads of what the previous step just stored);
 // - the two horizontal paths, the two vertical ones and the sum happen in one pass over the row;
@@ -130,8 +131,9 @@ void VerticalImpl(D d, const SgmCostRow& c_in, const SgmRowGeometry& g_in,
   const V last_ff = hn::IfThenZeroElse(hn::FirstN(d, static_cast<size_t>(n - 1)), ff);
   for (int x = 0; x < g.width; ++x) {
     V tab[8];
-    const uint32_t l = c.left[x];
-    for (int b = 0; b < planes; ++b) tab[b] = hn::LoadDup128(d, kNibbleDistance.v[(l >> (4 * b)) & 15]);
+    for (int b = 0; b < planes; ++b) {
+      tab[b] = hn::LoadDup128(d, kNibbleDistance.v[c.left[b * c.left_stride + x]]);
+    }
     const uint8_t* right = c.nibbles + (g.rev_base - x);
     const uint8_t* border = c.border + (g.rev_base - x);
     const bool at_border = x < c.safe_begin || x >= c.safe_end;
@@ -195,8 +197,9 @@ struct RowArgs {
 template <int kPlanes, class D>
 HWY_INLINE void CostTables(D d, const SgmCostRow& c, int x, hn::Vec<D>* tab) {
   const int planes = kPlanes > 0 ? kPlanes : c.planes;
-  const uint32_t l = c.left[x];
-  for (int b = 0; b < planes; ++b) tab[b] = hn::LoadDup128(d, kNibbleDistance.v[(l >> (4 * b)) & 15]);
+  for (int b = 0; b < planes; ++b) {
+    tab[b] = hn::LoadDup128(d, kNibbleDistance.v[c.left[b * c.left_stride + x]]);
+  }
 }
 
 template <int kPlanes, class D>
@@ -480,30 +483,67 @@ void FinishRowImpl(D d, const RowArgs& args, uint8_t* scratch, int16_t* right_be
 
 #endif  // HWY_TARGET != HWY_SCALAR && !HWY_HAVE_SCALABLE
 
-// Reversed right census of one row as nibble planes (SgmCostRow): plane b at out + b * stride,
-// index i = width - 1 + pad - xr, zeros outside [pad, pad + width) up to n_rev.
-static void FourPathNibblesSimd(const uint32_t* census, int width, int planes, int pad,
-                                int n_rev, uint8_t* out, int stride) {
-  const hn::CappedTag<int32_t, 8> di;
-  const hn::Rebind<uint8_t, decltype(di)> d8;
-  const int n = static_cast<int>(hn::Lanes(di));
-  const int32_t* src = reinterpret_cast<const int32_t*>(census);
-  for (int b = 0; b < planes; ++b) {
-    uint8_t* plane = out + static_cast<ptrdiff_t>(b) * stride;
-    std::fill(plane, plane + pad, uint8_t{0});
-    std::fill(plane + pad + width, plane + n_rev, uint8_t{0});
-    const int shift = 4 * b;
-    const auto mask = hn::Set(di, 15);
-    int xr = 0;
-    for (; xr + n <= width; xr += n) {
-      // Logical shift: the census has at most 32 bits, the mask drops what an arithmetic one
-      // would shift in.
-      const auto v = hn::And(hn::ShiftRightSame(hn::LoadU(di, src + xr), shift), mask);
-      hn::StoreU(hn::DemoteTo(d8, hn::Reverse(di, v)), d8, plane + (width + pad - xr - n));
+// Centre-symmetric census of one row (as CensusScalar) straight into nibble planes, 32 pixels
+// per vector: plane b holds bits [4b, 4b + 4). In x order at out + b * plane_stride + x, or
+// with `reversed` at index width - 1 + pad - x, zeros elsewhere below n_rev (SgmCostRow).
+static void FourPathCensusSimd(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch,
+                               uint8_t* out, int plane_stride, bool reversed, int pad,
+                               int n_rev) {
+  const int rx = cw / 2, ry = ch / 2;
+  const int bits = (cw * ch - 1) / 2;
+  const int planes = (bits + 3) / 4;
+  if (reversed) {
+    for (int b = 0; b < planes; ++b) {
+      uint8_t* plane = out + static_cast<ptrdiff_t>(b) * plane_stride;
+      std::fill(plane, plane + pad, uint8_t{0});
+      std::fill(plane + pad + width, plane + n_rev, uint8_t{0});
     }
-    for (; xr < width; ++xr) {
-      plane[width - 1 + pad - xr] = static_cast<uint8_t>((census[xr] >> shift) & 15);
+  }
+  const auto at = [&](int b, int x) {
+    return out + static_cast<ptrdiff_t>(b) * plane_stride + (reversed ? width - 1 + pad - x : x);
+  };
+  int x = 0;
+#ifdef CAIRN_SGM_FOUR_PATH_KERNELS
+  const hn::CappedTag<uint8_t, 32> d;
+  using V = hn::Vec<decltype(d)>;
+  const int n = static_cast<int>(hn::Lanes(d));
+  alignas(16) static constexpr uint8_t kReverse[16] = {15, 14, 13, 12, 11, 10, 9, 8,
+                                                       7,  6,  5,  4,  3,  2,  1, 0};
+  const auto reverse = [&](V v) {
+    v = hn::TableLookupBytes(v, hn::LoadDup128(d, kReverse));
+    if constexpr (hn::MaxLanes(decltype(d)()) == 32) v = hn::ConcatLowerUpper(d, v, v);
+    return v;
+  };
+  for (; x + n <= width; x += n) {
+    V nib[8];
+    for (int b = 0; b < planes; ++b) nib[b] = hn::Zero(d);
+    int bit = bits - 1;  // the first pair sets the most significant bit
+    for (int dy = -ry; dy <= 0; ++dy) {
+      for (int dx = -rx; dx <= rx; ++dx) {
+        if (dy == 0 && dx == 0) break;
+        const V a = hn::LoadU(d, center + dy * stride + x + dx);
+        const V b = hn::LoadU(d, center - dy * stride + x - dx);
+        // a > b: min(a, b) != a.
+        const V set = hn::AndNot(hn::VecFromMask(d, hn::Eq(hn::Min(a, b), a)),
+                                 hn::Set(d, static_cast<uint8_t>(1u << (bit & 3))));
+        nib[bit >> 2] = hn::Or(nib[bit >> 2], set);
+        --bit;
+      }
     }
+    for (int b = 0; b < planes; ++b) {
+      hn::StoreU(reversed ? reverse(nib[b]) : nib[b], d, reversed ? at(b, x + n - 1) : at(b, x));
+    }
+  }
+#endif
+  for (; x < width; ++x) {
+    uint32_t v = 0;
+    for (int dy = -ry; dy <= 0; ++dy) {
+      for (int dx = -rx; dx <= rx; ++dx) {
+        if (dy == 0 && dx == 0) break;
+        v = (v << 1) | (center[dy * stride + x + dx] > center[-dy * stride + x - dx] ? 1u : 0u);
+      }
+    }
+    for (int b = 0; b < planes; ++b) *at(b, x) = static_cast<uint8_t>((v >> (4 * b)) & 15);
   }
 }
 
@@ -599,7 +639,7 @@ namespace {
 HWY_EXPORT(HasFourPathSimd);
 HWY_EXPORT(FourPathVerticalSimd);
 HWY_EXPORT(FourPathFinishRowSimd);
-HWY_EXPORT(FourPathNibblesSimd);
+HWY_EXPORT(FourPathCensusSimd);
 
 void Vertical(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
               const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
@@ -621,15 +661,16 @@ void FinishRow(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* imag
                                               scratch, best, offset, right_best);
 }
 
-void Nibbles(const uint32_t* census, int width, int planes, int pad, int n_rev, uint8_t* out,
-             int stride) {
-  HWY_DYNAMIC_DISPATCH(FourPathNibblesSimd)(census, width, planes, pad, n_rev, out, stride);
+void Census(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch, uint8_t* out,
+            int plane_stride, bool reversed, int pad, int n_rev) {
+  HWY_DYNAMIC_DISPATCH(FourPathCensusSimd)(center, stride, width, cw, ch, out, plane_stride,
+                                           reversed, pad, n_rev);
 }
 
 }  // namespace
 
 const SgmFourPathKernels* SimdFourPathKernels() {
-  static const SgmFourPathKernels kernels{Vertical, FinishRow, Nibbles};
+  static const SgmFourPathKernels kernels{Vertical, FinishRow, Census};
   return HWY_DYNAMIC_DISPATCH(HasFourPathSimd)() ? &kernels : nullptr;
 }
 
