@@ -98,54 +98,74 @@ void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int 
 
 void DisparityFilter::FillBand(int16_t* disparity, int width, int height, int y0, int y1,
                                int max_size, int max_diff, Band& band) {
-  const size_t band_pixels = static_cast<size_t>(y1 - y0) * width;
-  std::fill_n(label_.begin() + static_cast<ptrdiff_t>(y0) * width, band_pixels, 0);
-  band.stack.resize(2 * band_pixels);  // (x, y) pairs: no division per visited pixel
-  band.region.resize(band_pixels);
+  const int rows = y1 - y0;
+  const int pw = width + 2;
+  const size_t cells = static_cast<size_t>(pw) * (rows + 2);
+  band.visited.resize(cells);
+  band.disparity.resize(cells);
+  band.stack.resize(static_cast<size_t>(rows) * width);
+  band.region.resize(static_cast<size_t>(rows) * width);
+  band.top_id.assign(static_cast<size_t>(width), 0);
+  band.bottom_id.assign(static_cast<size_t>(width), 0);
   band.open.clear();
   band.open_pixels.clear();
+  uint8_t* visited = band.visited.data();
+  int16_t* disp = band.disparity.data();
+  std::fill_n(visited, pw, uint8_t{1});
+  std::fill_n(visited + static_cast<size_t>(rows + 1) * pw, pw, uint8_t{1});
+  for (int r = 0; r < rows; ++r) {
+    const int16_t* src = disparity + static_cast<size_t>(y0 + r) * width;
+    uint8_t* v = visited + static_cast<size_t>(r + 1) * pw;
+    int16_t* d = disp + static_cast<size_t>(r + 1) * pw;
+    v[0] = v[width + 1] = 1;
+    d[0] = d[width + 1] = kInvalidDisparity;
+    for (int x = 0; x < width; ++x) {
+      d[x + 1] = src[x];
+      v[x + 1] = src[x] == kInvalidDisparity ? 1 : 0;
+    }
+  }
   int32_t* stack = band.stack.data();
   int32_t* region = band.region.data();
-  int32_t* label = label_.data();
-  // Rows whose regions may continue into the next band.
-  const int open_top = y0 > 0 ? y0 : -1, open_bottom = y1 < height ? y1 - 1 : -1;
-  for (int sy = y0; sy < y1; ++sy) {
-    for (int sx = 0; sx < width; ++sx) {
-      const int32_t start = sy * width + sx;
-      if (label[start] != 0 || disparity[start] == kInvalidDisparity) continue;
+  // Cells of the first and the last row of the band; they matter where another band follows.
+  const int32_t first_end = pw + width + 1, last_begin = rows * pw + 1;
+  const bool open_top = y0 > 0, open_bottom = y1 < height;
+  for (int r = 0; r < rows; ++r) {
+    for (int x = 0; x < width; ++x) {
+      const int32_t start = (r + 1) * pw + x + 1;
+      if (visited[start] != 0) continue;
       // Flood fill, remembering the members so that a small region can be cleared afterwards.
-      const int32_t id = start + 1;
+      const int32_t id = (y0 + r) * width + x + 1;
       int top = 0, count = 0;
       bool open = false;
-      stack[top++] = sx;
-      stack[top++] = sy;
-      label[start] = id;
+      stack[top++] = start;
+      visited[start] = 1;
       while (top > 0) {
-        const int py = stack[--top];
-        const int px = stack[--top];
-        const int32_t p = py * width + px;
+        const int32_t p = stack[--top];
         region[count++] = p;
-        open |= py == open_top || py == open_bottom;
-        const int16_t dp = disparity[p];
-        const auto visit = [&](int qx, int qy) {
-          const int32_t q = qy * width + qx;
-          if (label[q] != 0) return;
-          const int16_t dq = disparity[q];
-          if (dq == kInvalidDisparity || std::abs(dq - dp) > max_diff) return;
-          label[q] = id;
-          stack[top++] = qx;
-          stack[top++] = qy;
-        };
-        if (px > 0) visit(px - 1, py);
-        if (px + 1 < width) visit(px + 1, py);
-        if (py > y0) visit(px, py - 1);
-        if (py + 1 < y1) visit(px, py + 1);
+        if (p < first_end) {
+          band.top_id[static_cast<size_t>(p - pw - 1)] = id;
+          open |= open_top;
+        }
+        if (p >= last_begin) {
+          band.bottom_id[static_cast<size_t>(p - last_begin)] = id;
+          open |= open_bottom;
+        }
+        const int dp = disp[p];
+        for (const int32_t q : {p - 1, p + 1, p - pw, p + pw}) {
+          if (visited[q] != 0 || std::abs(disp[q] - dp) > max_diff) continue;
+          visited[q] = 1;
+          stack[top++] = q;
+        }
       }
       if (open) {
         band.open.push_back({id, count, band.open_pixels.size()});
         if (count < max_size) band.open_pixels.insert(band.open_pixels.end(), region, region + count);
       } else if (count < max_size) {
-        for (int i = 0; i < count; ++i) disparity[region[i]] = kInvalidDisparity;
+        for (int i = 0; i < count; ++i) {
+          const int32_t p = region[i];
+          const int py = p / pw - 1, px = p % pw - 1;  // only for the few cleared pixels
+          disparity[static_cast<size_t>(y0 + py) * width + px] = kInvalidDisparity;
+        }
       }
     }
   }
@@ -154,8 +174,6 @@ void DisparityFilter::FillBand(int16_t* disparity, int width, int height, int y0
 void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, int max_size,
                                      int max_diff, WorkerPool* pool) {
   if (max_size <= 0) return;
-  const size_t n = static_cast<size_t>(width) * height;
-  label_.resize(n);  // no reallocation once the size was seen
   // Bands of at least 32 rows, one per thread.
   const int bands = std::max(1, std::min(pool != nullptr ? pool->threads() : 1, height / 32));
   bands_.resize(static_cast<size_t>(bands));
@@ -199,8 +217,8 @@ void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, 
   for (int b = 1; b < bands; ++b) {
     int y0, y1;
     band_rows(b, &y0, &y1);
-    const int32_t* above = label_.data() + static_cast<size_t>(y0 - 1) * width;
-    const int32_t* below = label_.data() + static_cast<size_t>(y0) * width;
+    const int32_t* above = bands_[static_cast<size_t>(b - 1)].bottom_id.data();
+    const int32_t* below = bands_[static_cast<size_t>(b)].top_id.data();
     const int16_t* da = disparity + static_cast<size_t>(y0 - 1) * width;
     const int16_t* db = disparity + static_cast<size_t>(y0) * width;
     for (int x = 0; x < width; ++x) {
@@ -212,10 +230,17 @@ void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, 
       size[static_cast<size_t>(ra)] += size[static_cast<size_t>(rb)];
     }
   }
-  for (const Band& band : bands_) {
+  const int pw = width + 2;
+  for (int b = 0; b < bands; ++b) {
+    int y0, y1;
+    band_rows(b, &y0, &y1);
+    const Band& band = bands_[static_cast<size_t>(b)];
     for (const Open& o : band.open) {
       if (o.size >= max_size || size[static_cast<size_t>(find(index_of(o.id)))] >= max_size) continue;
-      for (int32_t i = 0; i < o.size; ++i) disparity[band.open_pixels[o.first_pixel + i]] = kInvalidDisparity;
+      for (int32_t i = 0; i < o.size; ++i) {
+        const int32_t p = band.open_pixels[o.first_pixel + i];
+        disparity[static_cast<size_t>(y0 + p / pw - 1) * width + p % pw - 1] = kInvalidDisparity;
+      }
     }
   }
 }

@@ -33,14 +33,18 @@ class DisparityFilter {
     int32_t id, size;
     size_t first_pixel;  // its pixels in Band::open_pixels (kept only while size < max_size)
   };
+  // One band of rows [y0, y1) in a padded copy: (width + 2) x (rows + 2) cells, the frame
+  // marked visited, so that a flood fill needs no bounds checks; invalid pixels start visited.
   struct Band {
-    std::vector<int32_t> stack, region, open_pixels;
+    std::vector<uint8_t> visited;
+    std::vector<int16_t> disparity;
+    std::vector<int32_t> stack, region, open_pixels;  // padded cell indices
+    std::vector<int32_t> top_id, bottom_id;            // region ids along the first, last row
     std::vector<Open> open;
   };
   void FillBand(int16_t* disparity, int width, int height, int y0, int y1, int max_size,
                 int max_diff, Band& band);
 
-  std::vector<int32_t> label_;  // region id (its first pixel + 1), 0 = not visited
   std::vector<Band> bands_;
   std::vector<int32_t> parent_;
 };
