@@ -287,13 +287,14 @@ HWY_INLINE hn::Vec<D> FirstVisit(D d, const RowArgs& a, int x, const uint8_t* hp
   return MinAllU8(d, best_h);
 }
 
-// Right-image minima: one copy per direction of the second visits and x parity, so that no load
-// waits for the store of the pixel before. Ascending x keeps the first of equal sums (strict <),
+// Right-image minima: one copy per direction of the second visits (the pixel before in the same
+// copy was stored a whole step of the other direction earlier, so no load waits for its store).
+// Ascending x keeps the first of equal sums (strict <),
 // descending x the last (<=): both the smallest k, as the golden model's scan.
 template <class T>
 struct RightMinima {
-  T* min[4];
-  T* k[4];
+  T* min[2];
+  T* k[2];
 };
 
 // The second of the two horizontal paths to reach pixel x: its step, the complete sum (into
@@ -385,7 +386,7 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
                                          ? SgmSubpixelOffset(s[bk - 1], s[bk], s[bk + 1])
                                          : 0);  // (not needed where the pixel is not unique)
   // The right-image minima over the diagonal of x.
-  const int copy = (kAscending ? 0 : 2) + (x & 1);
+  const int copy = kAscending ? 0 : 1;
   T* rmin = rm.min[copy] + (g.rev_base - x);
   T* rk = rm.k[copy] + (g.rev_base - x);
   VT kv = hn::Iota(dt, 0);
@@ -431,7 +432,7 @@ void FinishRowImpl(D d, const RowArgs& args, uint8_t* scratch, int16_t* right_be
   const size_t stride = (static_cast<size_t>(n_rev) + 64 + 31) & ~size_t{31};
   T* minima = reinterpret_cast<T*>(scratch + 4 * dc + 2 * dc * sizeof(SumT) + 64);
   RightMinima<T> rm;
-  for (int r = 0; r < 4; ++r) {
+  for (int r = 0; r < 2; ++r) {
     rm.min[r] = minima + 2 * r * stride;
     rm.k[r] = rm.min[r] + stride;
     std::fill(rm.min[r], rm.min[r] + n_rev, static_cast<T>(kMaxT));
@@ -468,7 +469,7 @@ void FinishRowImpl(D d, const RowArgs& args, uint8_t* scratch, int16_t* right_be
     const size_t i_rev = static_cast<size_t>(g.rev_base - g.min_disparity - xr);
     uint32_t bm = kMaxT;
     int bkk = -1;
-    for (int r = 0; r < 4; ++r) {
+    for (int r = 0; r < 2; ++r) {
       const uint32_t v = static_cast<uint32_t>(rm.min[r][i_rev]);
       if (v == kMaxT) continue;
       const int kk = static_cast<int>(static_cast<std::make_unsigned_t<T>>(rm.k[r][i_rev]));
