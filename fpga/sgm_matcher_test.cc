@@ -14,6 +14,7 @@
 
 #include "fpga/disparity_evaluator.h"
 #include "fpga/opencv_sgbm_matcher.h"
+#include "fpga/stereo_depth.h"
 #include "fpga/stereo_image_io.h"
 #include "mapping/stereo_error_model.h"
 
@@ -358,6 +359,35 @@ TEST(SgmMatcherTest, DepthAndSigmaFollowTheErrorModel) {
     ++checked;
   }
   EXPECT_GT(checked, w * h / 2);
+}
+
+// The tabulated depth is the direct formula's float, bit for bit.
+TEST(SgmMatcherTest, DepthTableGivesTheDirectFloats) {
+  std::mt19937 rng(9);
+  StereoMatcherOutput out;
+  ResizeStereoOutput(301, 40, &out);
+  for (auto& d : out.disparity) {
+    d = rng() % 9 == 0 ? kInvalidDisparity : static_cast<int16_t>(static_cast<int>(rng() % 2300) - 40);
+  }
+  StereoMatcherInput in;
+  in.width = 301;
+  in.height = 40;
+  in.focal_px = 512.3;
+  in.baseline_m = 0.11;
+  in.disparity_offset_px = 0.7;
+  ComputeStereoDepth(in, 0.5, &out, 0, 40);
+  const StereoErrorModel model(in.focal_px, in.baseline_m, 0.5);
+  for (size_t i = 0; i < out.disparity.size(); ++i) {
+    const int16_t d = out.disparity[i];
+    const double disp = static_cast<double>(d) / kDisparityScale + in.disparity_offset_px;
+    if (d == kInvalidDisparity || disp <= 0.0) {
+      ASSERT_TRUE(std::isnan(out.depth[i]) && std::isnan(out.depth_sigma[i])) << i;
+      continue;
+    }
+    const double z = in.focal_px * in.baseline_m / disp;
+    ASSERT_EQ(out.depth[i], static_cast<float>(z)) << i;
+    ASSERT_EQ(out.depth_sigma[i], static_cast<float>(model.DepthError(z))) << i;
+  }
 }
 
 TEST(SgmMatcherTest, RejectsBadInputAndOptions) {
