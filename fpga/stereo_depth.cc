@@ -1,5 +1,7 @@
 #include "fpga/stereo_depth.h"
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -40,6 +42,13 @@ void ComputeStereoDepth(const StereoMatcherInput& input, double pixel_error_px,
     *depth = static_cast<float>(z);
     *sigma = static_cast<float>(model.DepthError(z));
   };
+  if (!geometry) {
+    std::fill(out->depth.begin() + static_cast<ptrdiff_t>(begin),
+              out->depth.begin() + static_cast<ptrdiff_t>(end), nan);
+    std::fill(out->depth_sigma.begin() + static_cast<ptrdiff_t>(begin),
+              out->depth_sigma.begin() + static_cast<ptrdiff_t>(end), nan);
+    return;
+  }
   // They depend on the value alone, and a matcher's values span a few thousand: a table of the
   // values that occur gives the same floats at a fraction of the divisions.
   int lo = INT16_MAX, hi = INT16_MIN;
