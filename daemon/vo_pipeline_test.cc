@@ -124,12 +124,24 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   const testing::RenderedPair view = scene.Render(Eigen::Isometry3d::Identity());
   const Image left = MakeImage(view.left, cam.width, cam.height), right = MakeImage(view.right, cam.width, cam.height);
   const int64_t t0 = 1'000'000'000;
-  for (int k = 0; k <= 600; ++k) {  // 3 s at 200 Hz, paced like a device (a full queue drops)
+  const auto dense_taken = [&p] {
+    for (const QueueReport& q : p.queue_reports()) {
+      if (q.name == "dense") return q.pushed;
+    }
+    return uint64_t{0};
+  };
+  // 1 s of IMU first: the filter initializes (0.5 s still window) before the first pair. Then IMU
+  // and 20 Hz pairs paced like devices (a full queue drops), until mapping has taken a few pairs
+  // however slow this machine is (sanitizers, parallel tests), within 60 s of data.
+  uint64_t taken_at_start = 0;
+  for (int k = 0; k <= 12000; ++k) {
     const Timestamp t = Timestamp::FromNanoseconds(t0 + k * 5'000'000LL);
     ImuSample s;
     s.time = t;
     s.accel = Eigen::Vector3d(0.0, 0.0, 9.81);
     p.OnImu(s);
+    if (k < 200) continue;
+    if (k == 200) taken_at_start = dense_taken();
     if (k % 10 == 0) {
       StereoFrame f;
       f.time = t;
@@ -139,6 +151,7 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
       p.OnStereo(f);
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (k >= 600 && dense_taken() >= taken_at_start + 4) break;
   }
   p.StopAndDrain();
   const MappingStageReport m = p.mapping_report();
@@ -147,7 +160,7 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   EXPECT_EQ(m.mapping_errors, 0u);
   EXPECT_GT(m.images_mapped, 0u);
   EXPECT_GT(m.mapper.points, 0);
-  EXPECT_EQ(m.submaps_finished, 1u);  // the camera does not move: one submap, finished at the end
+  EXPECT_GE(m.submaps_finished, 1u);  // the open one, finished at the end
   EXPECT_GT(m.map_points, 0u);
   // Every pair that entered the dense queue was matched; what did not fit is counted as dropped.
   bool found = false;
