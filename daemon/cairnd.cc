@@ -108,7 +108,7 @@ int Cairnd::Run() {
   run.mode = options_.source == SourceKind::kReplay ? "replay" : options_.source == SourceKind::kSim ? "sim" : "live";
 
   const ExecutorsOptions& ex = options_.executors;
-  if (ex.estimation.realtime || ex.stereo.realtime || ex.telemetry.realtime) {
+  if (ex.estimation.realtime || ex.stereo.realtime || ex.mapping.realtime || ex.telemetry.realtime) {
     run.memory_locked = Executor::LockProcessMemory(&run.memory_lock_note);
   }
 
@@ -127,9 +127,22 @@ int Cairnd::Run() {
     setup.filter = options_.filter;
     setup.vo = options_.vo;
     setup.frame_switch = options_.frame_switch;
+    // With mapping, submap partitioning decides when the frame switches.
+    if (options_.mapping.enabled) setup.frame_switch.enabled = false;
     if (Status s = pipeline.EnableEstimation(setup); !s.ok()) {
       spdlog::error("{}: {}", options_.source == SourceKind::kSim ? "sim" : options_.replay.dataset, s.ToString());
       return 1;
+    }
+    if (options_.mapping.enabled && options_.vo.enabled) {
+      MappingSetup mapping;
+      mapping.robot = options_.robot.name;
+      mapping.stereo = options_.stereo;
+      mapping.mapping = options_.mapping;
+      mapping.output_dir = options_.output.dir;
+      if (Status s = pipeline.EnableMapping(mapping); !s.ok()) {
+        spdlog::error("{}: {}", config_path_, s.ToString());
+        return 1;
+      }
     }
   }
   std::unique_ptr<TelemetryStage> telemetry;
@@ -152,7 +165,7 @@ int Cairnd::Run() {
   pipeline.Start();
   // Everything the system refused of the requested scheduling, in one warning.
   std::string refused;
-  if ((ex.estimation.realtime || ex.stereo.realtime || ex.telemetry.realtime) && !run.memory_locked) {
+  if ((ex.estimation.realtime || ex.stereo.realtime || ex.mapping.realtime || ex.telemetry.realtime) && !run.memory_locked) {
     refused = "memory not locked (" + run.memory_lock_note + ")";
   }
   for (const ExecutorReport& e : pipeline.executor_reports()) {

@@ -11,6 +11,10 @@ Expected<CairndOptions> LoadCairndOptions(const std::string& path,
   CairndOptions options;
   YamlOptionsReader reader(doc->root, path, doc->overridden_keys);
   CAIRN_RETURN_IF_ERROR(reader.Read(options));
+  if (options.mapping.enabled && !(options.stereo.enabled && options.vo.enabled)) {
+    return InvalidArgumentError(path + ": mapping.enabled needs stereo.enabled (dense depth) and vo.enabled "
+                                       "(the filter's poses)");
+  }
   return options;
 }
 

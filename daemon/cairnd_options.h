@@ -5,8 +5,10 @@
 #include <cctype>
 #include <string>
 
+#include "daemon/dense_stereo_options.h"
 #include "daemon/executor_options.h"
 #include "daemon/live_stream_options.h"
+#include "daemon/mapping_stage_options.h"
 #include "daemon/recording_options.h"
 #include "daemon/sim_source_options.h"
 #include "drivers/can_wheel_options.h"
@@ -73,6 +75,8 @@ struct CairndOptions {
   FilterOptions filter;
   VoOptions vo;
   FrameSwitchOptions frame_switch;
+  DenseStereoOptions stereo;
+  MappingStageOptions mapping;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -90,6 +94,8 @@ struct CairndOptions {
     v.Section("filter", filter);
     v.Section("vo", vo);
     v.Section("frame_switch", frame_switch);
+    v.Section("stereo", stereo);
+    v.Section("mapping", mapping);
   }
 };
 

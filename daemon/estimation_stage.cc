@@ -101,15 +101,17 @@ void EstimationStage::Emit(const PendingFrame& f) {
     e.T_first_body = T_first_frame_[pose.frame_id % T_first_frame_.size()] * pose.T_frame_body;
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pose.covariance.topLeftCorner<3, 3>());
     e.position_sigma = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+    e.position_covariance = pose.covariance.topLeftCorner<3, 3>();
   }
   if (estimates_->TryPush(e)) {
     ++report_.estimates_emitted;
   } else {
     ++report_.estimates_dropped;
   }
+  if (mapping_estimates_ != nullptr && !mapping_estimates_->TryPush(e)) ++report_.mapping_estimates_dropped;
 }
 
-void EstimationStage::OnFrameSwitch(const FrameSwitchRequest& request) {
+void EstimationStage::OnFrameSwitch(const FilterSwitchRequest& request) {
   const uint64_t old_id = filter_.frame_id();
   const FrameSwitchResult r = filter_.RequestFrameSwitch();
   if (r.result != FilterResult::kApplied) return;
@@ -117,6 +119,10 @@ void EstimationStage::OnFrameSwitch(const FrameSwitchRequest& request) {
       T_first_frame_[old_id % T_first_frame_.size()] * r.transform.T_old_new;
   ++report_.frame_switches;
   ++report_.switch_reasons[static_cast<size_t>(request.reason)];
+  if (switch_events_ != nullptr &&
+      !switch_events_->TryPush(FrameSwitchEvent{r.time, r.old_frame_id, r.new_frame_id, r.transform})) {
+    ++report_.switch_events_dropped;
+  }
 }
 
 EstimationReport EstimationStage::report() const {

@@ -27,6 +27,7 @@ struct FrameEstimate {
   Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_first_body = Eigen::Isometry3d::Identity();  // chained through switches
   double position_sigma = 0.0;  // m, largest standard deviation of the position
+  Eigen::Matrix3d position_covariance = Eigen::Matrix3d::Zero();  // m^2, in the local frame
   VoStatus vo_status = VoStatus::kNoKeyframe;
   // The keyframe the odometry used has no clone in the filter (filter not yet initialized, or the
   // clone is gone): the odometry must stop using it.
@@ -34,9 +35,20 @@ struct FrameEstimate {
   Timestamp keyframe_time;
 };
 
-struct FrameSwitchRequest {
+// A frame switch asked of the filter (by the odometry's interim policy or by mapping's submap
+// partitioning); the filter switches at its current time.
+struct FilterSwitchRequest {
   Timestamp time;  // of the estimate that prompted it
   FrameSwitchReason reason = FrameSwitchReason::kNone;
+};
+
+// A frame switch the filter made: the new local frame (= new submap origin) in the old one, with
+// its covariance, for mapping (rolling map, submap chain) and the SLAM graph (factor w).
+struct FrameSwitchEvent {
+  Timestamp time;
+  uint64_t old_frame_id = 0;
+  uint64_t new_frame_id = 0;
+  FrameTransform transform;
 };
 
 struct EstimationReport {
@@ -50,6 +62,8 @@ struct EstimationReport {
   std::array<uint64_t, 3> switch_reasons{};  // by FrameSwitchReason
   uint64_t estimates_emitted = 0;
   uint64_t estimates_dropped = 0;  // output queue full
+  uint64_t mapping_estimates_dropped = 0;
+  uint64_t switch_events_dropped = 0;
   bool initialized = false;
 };
 
@@ -62,7 +76,13 @@ class EstimationStage {
   void OnWheel(const WheelOdometrySample& s);
   void OnFrame(Timestamp time);  // a stereo exposure: clone
   void OnVoResult(const VoResult& r);
-  void OnFrameSwitch(const FrameSwitchRequest& request);
+  void OnFrameSwitch(const FilterSwitchRequest& request);
+  // Also hands every per-frame estimate to `estimates` and every switch the filter makes to
+  // `switches` (the mapping stage); call before the thread starts.
+  void AlsoPublishTo(SpscQueue<FrameEstimate>* estimates, SpscQueue<FrameSwitchEvent>* switches) {
+    mapping_estimates_ = estimates;
+    switch_events_ = switches;
+  }
 
   bool initialized() const { return filter_.initialized(); }
   EstimationReport report() const;
@@ -85,6 +105,8 @@ class EstimationStage {
 
   LocalReferenceFilter filter_;
   SpscQueue<FrameEstimate>* estimates_;
+  SpscQueue<FrameEstimate>* mapping_estimates_ = nullptr;
+  SpscQueue<FrameSwitchEvent>* switch_events_ = nullptr;
   std::array<CloneEntry, 64> clones_{};
   size_t next_clone_slot_ = 0;
   std::array<PendingFrame, 32> pending_{};

@@ -38,12 +38,16 @@ struct ExecutorsOptions {
   ExecutorOptions estimation;  // the hard-real-time filter thread
   ExecutorOptions stereo;      // rectification, SGM, depth
   ExecutorOptions vo;          // keyframe stereo visual odometry
-  ExecutorOptions telemetry;   // recording (and later the live stream)
+  // Dense stereo (FPGA or SGM CPU kernel, whose `stereo.sgm.threads` workers it starts) and local
+  // mapping; apart from the stereo executor so the odometry never waits for dense matching.
+  ExecutorOptions mapping;
+  ExecutorOptions telemetry;   // recording and the live stream
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
     v.Section("stereo", stereo);
     v.Section("vo", vo);
+    v.Section("mapping", mapping);
     v.Section("telemetry", telemetry);
   }
 };
@@ -55,6 +59,8 @@ struct QueueOptions {
   int64_t stereo = 4;
   // Rectified pairs waiting for the visual odometry.
   int64_t vo = 4;
+  // Rectified pairs waiting for dense stereo and mapping.
+  int64_t dense = 2;
   // Samples waiting for the telemetry executor (recording, live stream); IMU gets 8x this.
   int64_t telemetry = 64;
 
@@ -63,6 +69,7 @@ struct QueueOptions {
     v.Integer("wheel_odometry", wheel_odometry, 2, 1 << 20, "samples");
     v.Integer("stereo", stereo, 2, 1024, "frames");
     v.Integer("vo", vo, 2, 1024, "frames");
+    v.Integer("dense", dense, 2, 1024, "frames");
     v.Integer("telemetry", telemetry, 2, 1 << 20, "samples");
   }
 };

@@ -26,10 +26,14 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       vo_result_queue_(32),
       switch_queue_(8),
       estimate_queue_(256),
+      dense_queue_(static_cast<size_t>(queues.dense)),
+      mapping_estimate_queue_(256),
+      switch_event_queue_(16),
       imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
       estimation_exec_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
       vo_("vo", executors.vo),
+      mapping_exec_("mapping", executors.mapping),
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
@@ -40,8 +44,10 @@ Pipeline::~Pipeline() { StopAndDrain(); }
 Status Pipeline::EnableEstimation(const EstimationSetup& setup) {
   if (started_) return FailedPreconditionError("EnableEstimation() after Start()");
   if (!setup.vo.enabled) return Status::Ok();
-  // Buffers for the pairs waiting in the queue, the one in the odometry and the one being written.
-  auto rectify = StereoRectifyStage::Create(setup.stereo, rectified_queue_.capacity() + 2);
+  // Buffers for the pairs waiting in the queues, the ones in the odometry and in dense matching,
+  // and the one being written.
+  auto rectify =
+      StereoRectifyStage::Create(setup.stereo, rectified_queue_.capacity() + dense_queue_.capacity() + 3);
   if (!rectify.ok()) return rectify.status().WithContext("stereo calibration");
   rectify_ = std::move(*rectify);
   vo_stage_ = std::make_unique<VoStage>(setup.vo, setup.frame_switch, rectify_->camera(), rectify_->T_body_cam());
@@ -49,12 +55,39 @@ Status Pipeline::EnableEstimation(const EstimationSetup& setup) {
   return Status::Ok();
 }
 
+Status Pipeline::EnableMapping(const MappingSetup& setup) {
+  if (started_) return FailedPreconditionError("EnableMapping() after Start()");
+  if (!estimation_) return FailedPreconditionError("mapping needs the estimation chain (vo.enabled)");
+  MappingSetup with_camera = setup;  // the rectified camera the odometry sees, too
+  with_camera.camera = rectify_->camera();
+  with_camera.T_body_cam = rectify_->T_body_cam();
+  auto stage = MappingStage::Create(with_camera, this);
+  if (!stage.ok()) return stage.status();
+  mapping_ = std::move(*stage);
+  dense_every_ = setup.stereo.every_nth_frame;
+  estimation_->AlsoPublishTo(&mapping_estimate_queue_, &switch_event_queue_);
+  return Status::Ok();
+}
+
+void Pipeline::SetTelemetry(TelemetryStage* telemetry) {
+  telemetry_ = telemetry;
+  if (mapping_) mapping_->SetTelemetry(telemetry);
+}
+
+MappingStageReport Pipeline::mapping_report() const {
+  MappingStageReport r = mapping_ ? mapping_->report() : MappingStageReport{};
+  r.switch_requests = mapping_switch_requests_;
+  return r;
+}
+
 void Pipeline::Start() {
   if (started_) return;
   started_ = true;
+  filter_running_.store(true, std::memory_order_release);
   estimation_exec_.Start([this](std::stop_token stop) { EstimationLoop(stop); });
   stereo_.Start([this](std::stop_token stop) { StereoLoop(stop); });
   if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
+  if (mapping_) mapping_exec_.Start([this](std::stop_token stop) { MappingLoop(stop); });
 }
 
 void Pipeline::StopAndDrain() {
@@ -69,13 +102,27 @@ void Pipeline::StopAndDrain() {
     vo_signal_.Notify();
     vo_.Join();
   }
+  // Mapping after the odometry (its pairs are all in) but before the filter: in deterministic
+  // mode its frame-switch requests wait for the estimation thread.
+  if (mapping_) {
+    mapping_exec_.RequestStop();
+    mapping_signal_.Notify();
+    mapping_exec_.Join();
+  }
+  filter_running_.store(false, std::memory_order_release);
   estimation_exec_.RequestStop();
   estimation_signal_.Notify();
   estimation_exec_.Join();
+  // What the filter emitted last is mapped too; the open submap is finished and the map written.
+  if (mapping_) {
+    TakeMappingInputs();
+    mapping_->Finish();
+  }
   // Estimates emitted after the odometry stopped.
   if (vo_stage_) {
     while (const FrameEstimate* e = estimate_queue_.Front()) {
       vo_stage_->OnEstimate(*e);
+      if (e->valid && telemetry_ != nullptr) telemetry_->OfferPose(e->time, e->T_first_body);
       estimate_queue_.PopFront();
     }
   }
@@ -119,8 +166,17 @@ void Pipeline::OnDeviceFault(const DeviceFault& fault) {
   spdlog::warn("device fault: {}: {}: {}", fault.device, DeviceFaultKindName(fault.kind), fault.detail);
 }
 
-void Pipeline::RequestFrameSwitch(const FrameSwitchRequest& request) {
+void Pipeline::RequestFilterSwitch(const FilterSwitchRequest& request) {
   Publish(switch_queue_, request, estimation_signal_);
+}
+
+void Pipeline::RequestFrameSwitch(const FrameSwitchRequest& request) {
+  // At the end of a run the filter has stopped: the last submap is finished without a switch.
+  if (!filter_running_.load(std::memory_order_acquire)) return;
+  ++mapping_switch_requests_;
+  RequestFilterSwitch(FilterSwitchRequest{request.time, request.reason == PartitionReason::kDistance
+                                                            ? FrameSwitchReason::kDistance
+                                                            : FrameSwitchReason::kPositionSigma});
 }
 
 void Pipeline::EstimationLoop(std::stop_token stop) {
@@ -158,6 +214,12 @@ void Pipeline::EstimationLoop(std::stop_token stop) {
           imu_stats_.Add(times[0]);
           if (estimation_) estimation_->OnImu(imu->value);
           if (telemetry_ != nullptr) telemetry_->OfferImu(imu->value);
+          // Live mode: wake mapping when an estimate it waits for came out (deterministic replays
+          // map at fixed points of the data flow instead, see MappingLoop).
+          if (mapping_ && !deterministic_ && mapping_estimate_queue_.pushed() != mapping_estimates_seen_) {
+            mapping_estimates_seen_ = mapping_estimate_queue_.pushed();
+            mapping_signal_.Notify();
+          }
           imu_queue_.PopFront();
           break;
         }
@@ -230,6 +292,9 @@ void Pipeline::StereoLoop(std::stop_token stop) {
           pair.dropped_before = pending_dropped_;
           pending_dropped_ = 0;
           Publish(rectified_queue_, pair, vo_signal_);
+          if (mapping_ && dense_counter_++ % static_cast<uint64_t>(dense_every_) == 0) {
+            Publish(dense_queue_, pair, mapping_signal_);
+          }
         } else {
           ++rectify_failures_;
         }
@@ -245,9 +310,10 @@ void Pipeline::StereoLoop(std::stop_token stop) {
 
 void Pipeline::DrainEstimates() {
   while (const FrameEstimate* e = estimate_queue_.Front()) {
-    const std::optional<FrameSwitchRequest> request = vo_stage_->OnEstimate(*e);
+    const std::optional<FilterSwitchRequest> request = vo_stage_->OnEstimate(*e);
+    if (e->valid && telemetry_ != nullptr) telemetry_->OfferPose(e->time, e->T_first_body);
     estimate_queue_.PopFront();
-    if (request) RequestFrameSwitch(*request);
+    if (request) RequestFilterSwitch(*request);
   }
 }
 
@@ -271,6 +337,49 @@ void Pipeline::VoLoop(std::stop_token stop) {
   }
 }
 
+void Pipeline::TakeMappingInputs() {
+  while (const FrameEstimate* e = mapping_estimate_queue_.Front()) {
+    mapping_->OnEstimate(*e);
+    mapping_estimate_queue_.PopFront();
+  }
+  while (const FrameSwitchEvent* e = switch_event_queue_.Front()) {
+    mapping_->OnFrameSwitch(*e);
+    switch_event_queue_.PopFront();
+  }
+}
+
+void Pipeline::MappingLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { mapping_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = mapping_signal_.sequence();
+    bool worked = false;
+    if (!deterministic_) {
+      TakeMappingInputs();
+      mapping_->ProcessReady(/*final=*/false);
+    }
+    while (const auto* queued = dense_queue_.Front()) {
+      if (deterministic_) {
+        // A fixed point of the data flow: everything the filter says about the earlier pairs is
+        // in (the publisher is held until this pair is taken), so the images waiting for those
+        // estimates are mapped, and any frame switch requested, at the same instant every run.
+        TakeMappingInputs();
+        mapping_->ProcessReady(/*final=*/false);
+      }
+      const RectifiedPair pair = queued->value;  // holds the image buffers
+      dense_queue_.PopFront();
+      if (deterministic_) consumed_signal_.Notify();
+      mapping_->OnPair(pair);
+      if (!deterministic_) {
+        TakeMappingInputs();
+        mapping_->ProcessReady(/*final=*/false);
+      }
+      worked = true;
+    }
+    if (stop.stop_requested() && dense_queue_.empty()) return;
+    if (!worked) mapping_signal_.WaitChange(seen);
+  }
+}
+
 std::vector<QueueReport> Pipeline::queue_reports() const {
   const auto r = [](const char* name, const auto& q) {
     return QueueReport{name, q.capacity(), q.pushed(), q.dropped(), q.high_water()};
@@ -283,13 +392,20 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
       out.push_back(q);
     }
   }
+  if (mapping_) {
+    for (QueueReport q : {r("dense", dense_queue_), r("mapping_estimate", mapping_estimate_queue_),
+                          r("frame_switch_event", switch_event_queue_)}) {
+      out.push_back(q);
+    }
+  }
   return out;
 }
 
 uint64_t Pipeline::total_dropped() const {
   return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
          rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
-         estimate_queue_.dropped();
+         estimate_queue_.dropped() + dense_queue_.dropped() + mapping_estimate_queue_.dropped() +
+         switch_event_queue_.dropped();
 }
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {
@@ -300,6 +416,7 @@ std::vector<LatencyReport> Pipeline::latency_reports() const {
 }
 
 std::vector<ExecutorReport> Pipeline::executor_reports() const {
+  if (mapping_) return {estimation_exec_.report(), stereo_.report(), vo_.report(), mapping_exec_.report()};
   if (estimation_) return {estimation_exec_.report(), stereo_.report(), vo_.report()};
   return {estimation_exec_.report(), stereo_.report()};
 }
@@ -309,7 +426,12 @@ std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
   const auto r = [](const char* name, const LatencyHistogram& h) {
     return StageTimingReport{name, h.count(), h.Quantile(0.5).seconds(), h.Quantile(0.99).seconds(), h.max().seconds()};
   };
-  return {r("rectify", rectify_time_), r("vo", vo_stage_->vo_time())};
+  std::vector<StageTimingReport> out = {r("rectify", rectify_time_), r("vo", vo_stage_->vo_time())};
+  if (mapping_) {
+    out.push_back(r("dense_stereo", mapping_->match_time()));
+    out.push_back(r("mapping", mapping_->map_time()));
+  }
+  return out;
 }
 
 EstimationReport Pipeline::estimation_report() const {

@@ -16,6 +16,7 @@
 #include "daemon/executor.h"
 #include "daemon/executor_options.h"
 #include "daemon/latency_histogram.h"
+#include "daemon/mapping_stage.h"
 #include "daemon/telemetry_stage.h"
 #include "daemon/sensor_stream_stats.h"
 #include "daemon/spsc_queue.h"
@@ -23,6 +24,7 @@
 #include "daemon/vo_stage.h"
 #include "hal/calibration.h"
 #include "hal/sensor_sink.h"
+#include "mapping/frame_switch_requester_interface.h"
 
 namespace cairn {
 
@@ -77,7 +79,7 @@ struct StageTimingReport {
   double p50 = 0.0, p99 = 0.0, max = 0.0;  // s
 };
 
-class Pipeline final : public SensorSink {
+class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
  public:
   Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues, PipelineRates rates,
            bool deterministic);
@@ -85,15 +87,23 @@ class Pipeline final : public SensorSink {
 
   // Hands every consumed sample on to `telemetry` (which must outlive the pipeline's threads).
   // Call before Start().
-  void SetTelemetry(TelemetryStage* telemetry) { telemetry_ = telemetry; }
+  void SetTelemetry(TelemetryStage* telemetry);
   // Runs the estimation chain on the data: stereo pairs are rectified (stereo executor), matched
   // by the keyframe visual odometry (vo executor) and fused with IMU and wheel data by the local
   // reference filter (estimation executor). Call before Start(). Without it the stages only
   // collect statistics.
   Status EnableEstimation(const EstimationSetup& setup);
-  // Asks the filter to switch its frame of reference (the path submap partitioning uses). From
-  // the vo thread (the interim distance/sigma policy) or, later, the mapping thread; one producer.
-  void RequestFrameSwitch(const FrameSwitchRequest& request);
+  // Runs dense stereo and local mapping on every `every_nth_frame`-th rectified pair (mapping
+  // executor; the camera is the rectified one of EnableEstimation), with the filter's estimates; mapping's submap partitioning then requests the frame
+  // switches. Needs EnableEstimation() first (the setup's frame_switch policy must be off); call
+  // before Start().
+  Status EnableMapping(const MappingSetup& setup);
+  // Asks the filter to switch its frame of reference. One producer: the vo thread (the interim
+  // distance/sigma policy) or, with mapping enabled, the mapping thread through the
+  // FrameSwitchRequesterInterface below.
+  void RequestFilterSwitch(const FilterSwitchRequest& request);
+  // Submap partitioning's request (mapping thread).
+  void RequestFrameSwitch(const FrameSwitchRequest& request) override;
   // Starts the stage threads.
   void Start();
   // Lets the stages consume what is queued, then joins them. Publishing must have stopped.
@@ -122,6 +132,9 @@ class Pipeline final : public SensorSink {
   const Trajectory* trajectory() const { return vo_stage_ ? &vo_stage_->trajectory() : nullptr; }
   const Trajectory* odometry() const { return vo_stage_ ? &vo_stage_->odometry() : nullptr; }
   uint64_t rectify_failures() const { return rectify_failures_; }
+  bool mapping_enabled() const { return mapping_ != nullptr; }
+  // Valid after StopAndDrain() when mapping is enabled.
+  MappingStageReport mapping_report() const;
   FaultReport fault_report() const;
 
   // Live progress (any thread).
@@ -142,7 +155,9 @@ class Pipeline final : public SensorSink {
   void EstimationLoop(std::stop_token stop);
   void StereoLoop(std::stop_token stop);
   void VoLoop(std::stop_token stop);
+  void MappingLoop(std::stop_token stop);
   void DrainEstimates();
+  void TakeMappingInputs();
 
   const bool deterministic_;
   WorkSignal estimation_signal_;
@@ -158,14 +173,22 @@ class Pipeline final : public SensorSink {
   SpscQueue<Queued<RectifiedPair>> rectified_queue_;
   SpscQueue<Queued<Timestamp>> clone_queue_;
   SpscQueue<Queued<VoResult>> vo_result_queue_;
-  SpscQueue<Queued<FrameSwitchRequest>> switch_queue_;
+  SpscQueue<Queued<FilterSwitchRequest>> switch_queue_;
   SpscQueue<FrameEstimate> estimate_queue_;
+  // Mapping: stereo -> mapping (every Nth rectified pair), estimation -> mapping (estimates and the
+  // switches made), mapping -> estimation (partitioning's requests, through switch_queue_).
+  WorkSignal mapping_signal_;
+  SpscQueue<Queued<RectifiedPair>> dense_queue_;
+  SpscQueue<FrameEstimate> mapping_estimate_queue_;
+  SpscQueue<FrameSwitchEvent> switch_event_queue_;
+  uint64_t mapping_estimates_seen_ = 0;  // estimation thread: when to wake the mapping thread
   const Duration imu_deadline_;
   std::atomic<uint64_t> deadline_misses_{0};
 
   Executor estimation_exec_;
   Executor stereo_;
   Executor vo_;
+  Executor mapping_exec_;
 
   // Owned by the estimation thread until joined.
   SensorStreamStats imu_stats_;
@@ -185,6 +208,11 @@ class Pipeline final : public SensorSink {
   LatencyHistogram rectify_time_;
   uint64_t rectify_failures_ = 0;
   int pending_dropped_ = 0;
+  std::unique_ptr<MappingStage> mapping_;
+  int64_t dense_every_ = 1;
+  uint64_t dense_counter_ = 0;  // stereo thread
+  uint64_t mapping_switch_requests_ = 0;  // mapping thread
+  std::atomic<bool> filter_running_{false};
 
   TelemetryStage* telemetry_ = nullptr;
   mutable std::mutex fault_mutex_;

@@ -116,6 +116,36 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("estimates_dropped", e.estimates_dropped);
     j.EndObject();
   }
+  if (p.mapping_enabled()) {
+    const MappingStageReport m = p.mapping_report();
+    j.Key("mapping").BeginObject();
+    j.Key("dense_stereo").BeginObject();
+    j.Field("backend", m.backend);
+    if (!m.device.empty()) j.Field("device", m.device);
+    j.Field("pairs", m.pairs);
+    j.Field("failures", m.match_failures);
+    j.Field("fpga_frames", m.fpga_frames).Field("cpu_frames", m.cpu_frames);
+    j.Field("fpga_failures", m.fpga_failures);
+    if (!m.fpga_status.empty()) j.Field("fpga_unused_because", m.fpga_status);
+    j.EndObject();
+    j.Field("images_mapped", m.images_mapped);
+    j.Field("images_without_pose", m.images_without_pose);
+    j.Field("images_dropped", m.images_dropped);
+    j.Field("errors", m.mapping_errors);
+    j.Field("points", m.mapper.points).Field("obstacle_points", m.mapper.obstacle_points);
+    j.Field("switch_requests", m.switch_requests);
+    j.Field("frame_switches", m.frame_switches);
+    j.Field("unannounced_frame_changes", m.mapper.unannounced_frame_changes);
+    j.Key("submaps").BeginObject();
+    j.Field("finished", m.submaps_finished).Field("written", m.submaps_written);
+    j.Field("write_failures", m.submap_write_failures).Field("bytes", m.submap_bytes);
+    j.EndObject();
+    j.Field("map_points", m.map_points).Field("map_voxels", m.map_voxels);
+    j.Key("first_errors").BeginArray();
+    for (const auto& e : m.errors) j.String(e);
+    j.EndArray();
+    j.EndObject();
+  }
   const FaultReport f = p.fault_report();
   j.Key("faults").BeginObject();
   j.Field("total", f.total);

@@ -8,6 +8,10 @@
 
 #include "cairn/sensors.pb.h"
 #include "foxglove/CompressedImage.pb.h"
+#include "foxglove/FrameTransform.pb.h"
+#include "foxglove/Grid.pb.h"
+#include "foxglove/PointCloud.pb.h"
+#include "foxglove/PoseInFrame.pb.h"
 #include "foxglove/RawImage.pb.h"
 
 namespace cairn {
@@ -33,6 +37,10 @@ const char* TelemetryTopicName(TelemetryTopic topic) {
     case TelemetryTopic::kCam1Image: return "/cam1/image";
     case TelemetryTopic::kCam0Compressed: return "/cam0/image/compressed";
     case TelemetryTopic::kCam1Compressed: return "/cam1/image/compressed";
+    case TelemetryTopic::kPose: return "/pose";
+    case TelemetryTopic::kTransform: return "/tf";
+    case TelemetryTopic::kSubmapCloud: return "/map/submaps";
+    case TelemetryTopic::kObstacleGrid: return "/map/obstacles";
   }
   return "";
 }
@@ -46,6 +54,10 @@ const google::protobuf::Descriptor* TelemetryTopicDescriptor(TelemetryTopic topi
     case TelemetryTopic::kCam1Image: return foxglove::RawImage::descriptor();
     case TelemetryTopic::kCam0Compressed:
     case TelemetryTopic::kCam1Compressed: return foxglove::CompressedImage::descriptor();
+    case TelemetryTopic::kPose: return foxglove::PoseInFrame::descriptor();
+    case TelemetryTopic::kTransform: return foxglove::FrameTransform::descriptor();
+    case TelemetryTopic::kSubmapCloud: return foxglove::PointCloud::descriptor();
+    case TelemetryTopic::kObstacleGrid: return foxglove::Grid::descriptor();
   }
   return nullptr;
 }

@@ -17,10 +17,12 @@
 
 namespace cairn {
 
+// Raw sensor samples first (what a recording replays), then what the daemon estimated.
 enum class TelemetryTopic {
-  kImu, kWheelOdometry, kStereoInfo, kCam0Image, kCam1Image, kCam0Compressed, kCam1Compressed
+  kImu, kWheelOdometry, kStereoInfo, kCam0Image, kCam1Image, kCam0Compressed, kCam1Compressed,
+  kPose, kTransform, kSubmapCloud, kObstacleGrid
 };
-inline constexpr int kTelemetryTopicCount = 7;
+inline constexpr int kTelemetryTopicCount = 11;
 
 const char* TelemetryTopicName(TelemetryTopic topic);
 const google::protobuf::Descriptor* TelemetryTopicDescriptor(TelemetryTopic topic);

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <limits>
 
 #include "daemon/json_writer.h"
@@ -15,6 +16,8 @@ TelemetryStage::TelemetryStage(const ExecutorOptions& executor, size_t queue_dep
       imu_(queue_depth * 8),  // IMU samples are small and frequent
       wheel_(queue_depth),
       stereo_(queue_depth),
+      poses_(queue_depth),
+      maps_(16),  // a few submaps and grids a minute; each holds its data by reference
       executor_("telemetry", executor) {}
 
 TelemetryStage::~TelemetryStage() { StopAndDrain(); }
@@ -101,6 +104,31 @@ void TelemetryStage::PublishDiagnostics(const std::string& status) {
 void TelemetryStage::OfferImu(const ImuSample& s) { Offer(imu_, s); }
 void TelemetryStage::OfferWheelOdometry(const WheelOdometrySample& s) { Offer(wheel_, s); }
 void TelemetryStage::OfferStereo(const StereoFrame& f) { Offer(stereo_, f); }
+void TelemetryStage::OfferPose(Timestamp time, const Eigen::Isometry3d& T_map_body) {
+  Offer(poses_, PoseItem{time, T_map_body});
+}
+void TelemetryStage::OfferSubmap(Timestamp time, std::shared_ptr<const Submap> submap,
+                                 const Eigen::Isometry3d& T_map_submap) {
+  Offer(maps_, MapItem{time, std::move(submap), nullptr, T_map_submap, 0.0});
+}
+void TelemetryStage::OfferObstacleGrid(Timestamp time, std::shared_ptr<const GridMap> grid,
+                                       const Eigen::Isometry3d& T_map_local, double z) {
+  Offer(maps_, MapItem{time, nullptr, std::move(grid), T_map_local, z});
+}
+
+bool TelemetryStage::Wanted(TelemetryTopic topic) const {
+  return recorder_ != nullptr || (live_ && live_->HasSubscribers(live_channel_[static_cast<int>(topic)]));
+}
+
+void TelemetryStage::HandleMap(const MapItem& m) {
+  // Clouds and grids are large: encoded only for a recorder or a subscribed client.
+  if (m.submap && Wanted(TelemetryTopic::kSubmapCloud)) {
+    Emit(TelemetryTopic::kSubmapCloud, m.time, estimates_.Cloud(m.time, m.T_map_frame, m.submap->points()));
+  }
+  if (m.grid && Wanted(TelemetryTopic::kObstacleGrid)) {
+    Emit(TelemetryTopic::kObstacleGrid, m.time, estimates_.Grid(m.time, m.T_map_frame, m.z, *m.grid));
+  }
+}
 
 void TelemetryStage::Emit(TelemetryTopic topic, Timestamp time, const std::string& encoded) {
   if (recorder_) {
@@ -173,25 +201,46 @@ void TelemetryStage::Loop(std::stop_token stop) {
     const uint32_t seen = work_.sequence();
     bool worked = false;
     while (true) {
+      // Oldest offer first, across all producers.
       const auto* i = imu_.Front();
       const auto* w = wheel_.Front();
       const auto* s = stereo_.Front();
-      const uint64_t si = i ? i->sequence : kNone, sw = w ? w->sequence : kNone, ss = s ? s->sequence : kNone;
-      if (si == kNone && sw == kNone && ss == kNone) break;
-      if (si <= sw && si <= ss) {
-        Emit(TelemetryTopic::kImu, i->value.time, encoder_.Imu(i->value));
-        imu_.PopFront();
-      } else if (sw <= ss) {
-        Emit(TelemetryTopic::kWheelOdometry, w->value.time, encoder_.WheelOdometry(w->value));
-        wheel_.PopFront();
-      } else {
-        HandleStereo(s->value);
-        stereo_.PopFront();
+      const auto* p = poses_.Front();
+      const auto* m = maps_.Front();
+      const uint64_t seq[5] = {i ? i->sequence : kNone, w ? w->sequence : kNone, s ? s->sequence : kNone,
+                               p ? p->sequence : kNone, m ? m->sequence : kNone};
+      const int k = static_cast<int>(std::min_element(seq, seq + 5) - seq);
+      if (seq[k] == kNone) break;
+      switch (k) {
+        case 0:
+          Emit(TelemetryTopic::kImu, i->value.time, encoder_.Imu(i->value));
+          imu_.PopFront();
+          break;
+        case 1:
+          Emit(TelemetryTopic::kWheelOdometry, w->value.time, encoder_.WheelOdometry(w->value));
+          wheel_.PopFront();
+          break;
+        case 2:
+          HandleStereo(s->value);
+          stereo_.PopFront();
+          break;
+        case 3:
+          Emit(TelemetryTopic::kPose, p->value.time, estimates_.Pose(p->value.time, p->value.T_map_body));
+          Emit(TelemetryTopic::kTransform, p->value.time, estimates_.Transform(p->value.time, p->value.T_map_body));
+          poses_.PopFront();
+          break;
+        default:
+          HandleMap(m->value);
+          maps_.PopFront();
+          break;
       }
       worked = true;
       space_.Notify();
     }
-    if (stop.stop_requested() && imu_.empty() && wheel_.empty() && stereo_.empty()) return;
+    if (stop.stop_requested() && imu_.empty() && wheel_.empty() && stereo_.empty() && poses_.empty() &&
+        maps_.empty()) {
+      return;
+    }
     if (!worked) work_.WaitChange(seen);
   }
 }

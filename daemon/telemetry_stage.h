@@ -9,12 +9,14 @@
 #include <memory>
 #include <string>
 
+#include "daemon/estimate_encoder.h"
 #include "daemon/executor.h"
 #include "daemon/foxglove_server.h"
 #include "daemon/live_stream_options.h"
 #include "daemon/mcap_recorder.h"
 #include "daemon/sample_encoder.h"
 #include "daemon/spsc_queue.h"
+#include "mapping/submap.h"
 
 namespace cairn {
 
@@ -41,13 +43,23 @@ class TelemetryStage {
   void OfferImu(const ImuSample& s);
   void OfferWheelOdometry(const WheelOdometrySample& s);
   void OfferStereo(const StereoFrame& f);
+  // The filter's body pose at a camera frame, in the robot's first local frame (one producer: the
+  // odometry thread, or the main thread once it has stopped).
+  void OfferPose(Timestamp time, const Eigen::Isometry3d& T_map_body);
+  // A finished submap placed in the first local frame, or a snapshot of the rolling obstacle map
+  // (one producer: the mapping thread, or the main thread once it has stopped).
+  void OfferSubmap(Timestamp time, std::shared_ptr<const Submap> submap, const Eigen::Isometry3d& T_map_submap);
+  void OfferObstacleGrid(Timestamp time, std::shared_ptr<const GridMap> grid, const Eigen::Isometry3d& T_map_local,
+                         double z);
   // The daemon's periodic status line, to the live /diagnostics channel (any thread).
   void PublishDiagnostics(const std::string& status);
 
   bool recording() const { return recorder_ != nullptr; }
   const RecordingReport& recording_report() const { return recorder_->report(); }
   LiveStreamReport live_report() const;
-  uint64_t dropped() const { return imu_.dropped() + wheel_.dropped() + stereo_.dropped(); }
+  uint64_t dropped() const {
+    return imu_.dropped() + wheel_.dropped() + stereo_.dropped() + poses_.dropped() + maps_.dropped();
+  }
   ExecutorReport executor_report() const { return executor_.report(); }
 
  private:
@@ -56,8 +68,21 @@ class TelemetryStage {
     uint64_t sequence = 0;
     T value{};
   };
+  struct PoseItem {
+    Timestamp time;
+    Eigen::Isometry3d T_map_body = Eigen::Isometry3d::Identity();
+  };
+  struct MapItem {
+    Timestamp time;
+    std::shared_ptr<const Submap> submap;  // or
+    std::shared_ptr<const GridMap> grid;
+    Eigen::Isometry3d T_map_frame = Eigen::Isometry3d::Identity();
+    double z = 0.0;
+  };
   template <class T>
   void Offer(SpscQueue<Item<T>>& queue, const T& value);
+  void HandleMap(const MapItem& m);
+  bool Wanted(TelemetryTopic topic) const;
   void Loop(std::stop_token stop);
   void Emit(TelemetryTopic topic, Timestamp time, const std::string& encoded);
   void HandleStereo(const StereoFrame& f);
@@ -72,7 +97,10 @@ class TelemetryStage {
   SpscQueue<Item<ImuSample>> imu_;
   SpscQueue<Item<WheelOdometrySample>> wheel_;
   SpscQueue<Item<StereoFrame>> stereo_;
+  SpscQueue<Item<PoseItem>> poses_;
+  SpscQueue<Item<MapItem>> maps_;
   SampleEncoder encoder_;
+  EstimateEncoder estimates_;
   std::unique_ptr<McapRecorder> recorder_;
   std::unique_ptr<FoxgloveServer> live_;
   uint32_t live_channel_[kTelemetryTopicCount] = {};

@@ -35,7 +35,7 @@ VoResult VoStage::Process(const RectifiedPair& pair) {
   return r;
 }
 
-std::optional<FrameSwitchRequest> VoStage::OnEstimate(const FrameEstimate& e) {
+std::optional<FilterSwitchRequest> VoStage::OnEstimate(const FrameEstimate& e) {
   ++report_.estimates;
   if (e.keyframe_clone_missing) {
     vo_.DropKeyframe(e.keyframe_time);
@@ -46,7 +46,7 @@ std::optional<FrameSwitchRequest> VoStage::OnEstimate(const FrameEstimate& e) {
   trajectory_.poses.push_back(StampedPose{e.time, e.T_first_body});
   const FrameSwitchReason reason = policy_.Update(e.frame_id, e.T_frame_body.translation(), e.position_sigma);
   if (reason == FrameSwitchReason::kNone) return std::nullopt;
-  return FrameSwitchRequest{e.time, reason};
+  return FilterSwitchRequest{e.time, reason};
 }
 
 }  // namespace cairn

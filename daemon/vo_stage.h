@@ -2,7 +2,7 @@
 // The odometry thread's work: keyframe stereo visual odometry on rectified pairs, the raw
 // odometry chain (vo.tum), the filter's per-frame estimates coming back (trajectory.tum,
 // keyframes whose clone is gone) and the frame-switch policy that stands in for submap
-// partitioning: its requests take the path mapping will use (Pipeline::RequestFrameSwitch).
+// partitioning: its requests take the path mapping will use (Pipeline::RequestFilterSwitch).
 
 #include <array>
 #include <cstdint>
@@ -34,7 +34,7 @@ class VoStage {
 
   VoResult Process(const RectifiedPair& pair);
   // The filter's estimate at a frame; returns a frame-switch request when one is due.
-  std::optional<FrameSwitchRequest> OnEstimate(const FrameEstimate& e);
+  std::optional<FilterSwitchRequest> OnEstimate(const FrameEstimate& e);
 
   const VoStageReport& report() const { return report_; }
   const Trajectory& trajectory() const { return trajectory_; }

@@ -53,22 +53,28 @@ struct FilterState {
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();
   std::array<CloneSlot, kMaxClones> clones{};
   StateCovariance P = StateCovariance::Zero();
-  // Propagation only changes the core-clone cross-covariance by left-multiplication with the
-  // transition matrix, so it is accumulated here and applied once, before anything reads it:
-  // the true cross block is phi * P.topRightCorner (see MaterializeCovariance).
-  Eigen::Matrix<double, kCoreDim, kCoreDim> phi = Eigen::Matrix<double, kCoreDim, kCoreDim>::Identity();
+  // Parts of P are kept deferred so that the work per IMU sample and per core-only update does
+  // not grow with the number of clones. While cross_pending is set:
+  //  - the core block P[0:15, 0:15] is current;
+  //  - the clone-core cross block of an active slot j is kept in the bottom-left block,
+  //    B_j = P[CloneIndex(j) + 0..5, 0:15]. It is current if cross_current[j], else the true block
+  //    is B_j phi^T: propagation and core-only updates (wheel, position) change the core-clone
+  //    cross-covariance by left-multiplication, which is accumulated in phi;
+  //  - of the clone-clone block, the 6x6 blocks on and below the block diagonal are current;
+  //  - the top-right block and the clone-clone blocks above the diagonal are stale.
+  // Free slots have all-zero rows and columns. MaterializeCovariance makes P complete.
+  Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor> phi =
+      Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor>::Identity();
+  std::array<bool, kMaxClones> cross_current{};
   bool cross_pending = false;
 };
 
-// Applies the accumulated transition to the core-clone cross-covariance, making P complete.
-inline void MaterializeCovariance(FilterState& s) {
-  if (!s.cross_pending) return;
-  constexpr int kCloneDims = kStateDim - kCoreDim;
-  const Eigen::Matrix<double, kCoreDim, kCloneDims> cross = s.phi * s.P.topRightCorner<kCoreDim, kCloneDims>();
-  s.P.topRightCorner<kCoreDim, kCloneDims>() = cross;
-  s.P.bottomLeftCorner<kCloneDims, kCoreDim>() = cross.transpose();
-  s.phi.setIdentity();
-  s.cross_pending = false;
-}
+// Makes every cross block current (applies phi, which becomes the identity).
+void MaterializeCross(FilterState& s);
+// Makes P complete and symmetric.
+void MaterializeCovariance(FilterState& s);
+// The true covariance of a clone with the core state (6x15), and the true clone-clone block (i, j).
+Eigen::Matrix<double, 6, kCoreDim> CrossRows(const FilterState& s, int slot);
+Matrix6d CloneBlock(const FilterState& s, int i, int j);
 
 }  // namespace cairn

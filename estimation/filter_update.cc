@@ -1,45 +1,141 @@
 #include "estimation/filter_update.h"
 
+#include <cmath>
+
 #include <Eigen/Cholesky>
 
+#include "estimation/filter_kernels.h"
 #include "estimation/so3.h"
 
 namespace cairn {
 namespace {
 
-// P H^T for an H that is zero outside the core columns.
-template <int M>
-Eigen::Matrix<double, kStateDim, M> CorePHt(const FilterState& s, const Eigen::Matrix<double, M, kStateDim>& H) {
-  return s.P.leftCols<kCoreDim>() * H.template leftCols<kCoreDim>().transpose();
+constexpr int kCloneDims = kStateDim - kCoreDim;
+using CoreMatrix = Eigen::Matrix<double, kCoreDim, kCoreDim>;
+
+bool Active(const FilterState& s, int slot) { return s.clones[static_cast<size_t>(slot)].id != kNoClone; }
+
+// Exp of a rotation vector as a unit quaternion; for the small corrections of an update the
+// Taylor series (exact to double precision below 1e-2 rad) avoids the trigonometric functions.
+Eigen::Quaterniond ExpCorrection(const Eigen::Vector3d& w) {
+  const double t2 = w.squaredNorm();
+  if (t2 >= 1e-4) return so3::ExpQuaternion(w);
+  const double x2 = 0.25 * t2;  // (theta / 2)^2
+  const double real = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+  const double imag = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+  return Eigen::Quaterniond(real, imag * w.x(), imag * w.y(), imag * w.z()).normalized();
 }
 
-// P H^T for an H that is zero outside two clone blocks.
-Eigen::Matrix<double, kStateDim, 6> ClonePHt(const FilterState& s, const Eigen::Matrix<double, 6, kStateDim>& H,
-                                             int ik, int ic) {
-  Eigen::Matrix<double, kStateDim, 6> PHt = s.P.middleCols<6>(ik) * H.middleCols<6>(ik).transpose();
-  PHt.noalias() += s.P.middleCols<6>(ic) * H.middleCols<6>(ic).transpose();
-  return PHt;
+// W <- W L^-T in place (L lower triangular), column by column.
+template <int N, int M>
+void SolveLowerTransposedRight(const Eigen::Matrix<double, M, M>& L, Eigen::Matrix<double, N, M>& W) {
+  for (int i = 0; i < M; ++i) {
+    for (int k = 0; k < i; ++k) W.col(i) -= L(i, k) * W.col(k);
+    W.col(i) /= L(i, i);
+  }
 }
 
-// The EKF update given P H^T (computed by the caller, exploiting H's sparsity). P must be
-// materialized (MaterializeCovariance) before PHt is formed.
+// z <- L^-1 z (forward substitution).
 template <int M>
-UpdateOutcome KalmanUpdate(FilterState& s, const Eigen::Matrix<double, M, kStateDim>& H,
-                           const Eigen::Matrix<double, kStateDim, M>& PHt,
-                           const Eigen::Matrix<double, M, 1>& r,
-                           const Eigen::Matrix<double, M, M>& R, double gate) {
-  Eigen::Matrix<double, M, M> S = H * PHt + R;
+void SolveLower(const Eigen::Matrix<double, M, M>& L, Eigen::Matrix<double, M, 1>& z) {
+  for (int i = 0; i < M; ++i) {
+    for (int k = 0; k < i; ++k) z(i) -= L(i, k) * z(k);
+    z(i) /= L(i, i);
+  }
+}
+
+// C <- C - V V^T on the current part (on and below the block diagonal) of the clone-clone
+// covariance, V the clone rows of an update's W = P H^T L^-T. Column block by column block: each
+// is one contiguous run of rows from its diagonal block down. Free slots' columns are left alone
+// (the rows of V for free slots are zero).
+template <int M>
+void SubtractCloneOuter(FilterState& s, const Eigen::Matrix<double, kCloneDims, M>& V) {
+  const Eigen::Matrix<double, M, kCloneDims> Vt = V.transpose();
+  for (int j = 0; j < kMaxClones; ++j) {
+    if (!Active(s, j)) continue;
+    const int row0 = 6 * j;
+    kernels::MulRows<M, 6, kernels::kSub>(&s.P(kCoreDim + row0, kCoreDim + row0), kStateDim, V.data() + row0,
+                                          kCloneDims, kCloneDims - row0, Vt.data() + M * row0, M);
+  }
+}
+
+// The EKF update for a measurement of the core state only (H zero on the clone columns), in the
+// deferred form of FilterState: with L L^T = S, W = P H^T L^-T and P <- P - W W^T, the
+// core-clone cross block changes as X <- (I - W_core L^-1 H) X (a left-multiplication, folded
+// into phi or applied to the current cross blocks) and the clone block by a rank-M downdate.
+template <int M>
+UpdateOutcome CoreUpdate(FilterState& s, const Eigen::Matrix<double, M, kCoreDim>& H,
+                         const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<double, M, M>& R,
+                         double gate) {
+  const CoreMatrix Pc = s.P.topLeftCorner<kCoreDim, kCoreDim>();
+  Eigen::Matrix<double, kCoreDim, M> W = Pc.lazyProduct(H.transpose());  // P H^T, then W_core
+  Eigen::Matrix<double, M, M> S = H.lazyProduct(W) + R;
   S = 0.5 * (S + S.transpose()).eval();
   const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
   if (llt.info() != Eigen::Success) return UpdateOutcome::kBadCovariance;
   if (gate > 0.0 && r.dot(llt.solve(r)) > gate) return UpdateOutcome::kGated;
-  // K = P H^T S^-1, computed as (S^-1 H P)^T.
-  const Eigen::Matrix<double, kStateDim, M> K = llt.solve(PHt.transpose()).transpose();
-  const Eigen::Matrix<double, kStateDim, 1> dx = K * r;
-  s.P.noalias() -= K * PHt.transpose();
-  s.P = 0.5 * (s.P + s.P.transpose()).eval();
+  const Eigen::Matrix<double, M, M> L = llt.matrixL();
+  SolveLowerTransposedRight<kCoreDim, M>(L, W);
+  Eigen::Matrix<double, kCoreDim, M> Gt = H.transpose();  // becomes (L^-1 H)^T
+  SolveLowerTransposedRight<kCoreDim, M>(L, Gt);
+  Eigen::Matrix<double, M, 1> z = r;
+  SolveLower<M>(L, z);
+  const Eigen::Matrix<double, kCoreDim, M> Gphi_t = s.phi.transpose().lazyProduct(Gt);  // (G phi)^T
+
+  // Clone rows of W: the true clone-core cross blocks times H^T L^-T.
+  Eigen::Matrix<double, kCloneDims, M> V;
+  kernels::MulRows<kCoreDim, M, kernels::kSet>(V.data(), kCloneDims, &s.P(kCoreDim, 0), kStateDim, kCloneDims,
+                                               Gphi_t.data(), kCoreDim);
+  for (int j = 0; j < kMaxClones; ++j) {
+    if (!Active(s, j) || !s.cross_current[static_cast<size_t>(j)]) continue;
+    kernels::MulRows<kCoreDim, M, kernels::kSet>(V.data() + 6 * j, kCloneDims, &s.P(CloneIndex(j), 0), kStateDim,
+                                                 6, Gt.data(), kCoreDim);
+  }
+  Eigen::Matrix<double, kStateDim, 1> dx;
+  dx.head<kCoreDim>() = W.lazyProduct(z);
+  dx.tail<kCloneDims>() = V.lazyProduct(z);
+
+  CoreMatrix core = Pc;
+  core -= W.lazyProduct(W.transpose());
+  s.P.topLeftCorner<kCoreDim, kCoreDim>() = 0.5 * (core + core.transpose());
+  s.phi -= W.lazyProduct(Gphi_t.transpose());
+  const Eigen::Matrix<double, M, kCoreDim> W_t = W.transpose();
+  for (int j = 0; j < kMaxClones; ++j) {
+    if (!Active(s, j) || !s.cross_current[static_cast<size_t>(j)]) continue;
+    kernels::MulRowsWide<M, kCoreDim, kernels::kSub>(&s.P(CloneIndex(j), 0), kStateDim, V.data() + 6 * j,
+                                                     kCloneDims, 6, W_t.data(), M);
+  }
+  SubtractCloneOuter<M>(s, V);
+  s.cross_pending = true;
   InjectError(s, dx);
   return UpdateOutcome::kApplied;
+}
+
+// Prediction of a relative pose between two clones and the non-zero 6x6 blocks of its Jacobian
+// (columns of the keyframe clone and of the current clone).
+void RelativePoseModel(const FilterState& s, const RelativePoseMeasurement& m, Eigen::Vector3d* t_hat,
+                       Eigen::Quaterniond* q_hat, Matrix6d* Hk, Matrix6d* Hc) {
+  const CloneSlot& k = s.clones[static_cast<size_t>(m.keyframe_slot)];
+  const CloneSlot& c = s.clones[static_cast<size_t>(m.current_slot)];
+  const Eigen::Matrix3d Rk = k.q_frame_imu.toRotationMatrix();
+  *t_hat = Rk.transpose() * (c.p_frame_imu - k.p_frame_imu);
+  *q_hat = k.q_frame_imu.conjugate() * c.q_frame_imu;
+  const Eigen::Matrix3d R_rel = q_hat->toRotationMatrix();
+  Hk->setZero();
+  Hc->setZero();
+  Hk->block<3, 3>(0, 0) = -Rk.transpose();
+  Hk->block<3, 3>(0, 3) = so3::Skew(*t_hat);
+  Hk->block<3, 3>(3, 3) = -R_rel.transpose();
+  Hc->block<3, 3>(0, 0) = Rk.transpose();
+  Hc->block<3, 3>(3, 3).setIdentity();
+}
+
+// Column block of the true P at a clone slot (87x6).
+Eigen::Matrix<double, kStateDim, 6> CloneColumns(const FilterState& s, int slot) {
+  Eigen::Matrix<double, kStateDim, 6> out;
+  out.topRows<kCoreDim>() = CrossRows(s, slot).transpose();
+  for (int i = 0; i < kMaxClones; ++i) out.middleRows<6>(CloneIndex(i)) = CloneBlock(s, i, slot);
+  return out;
 }
 
 }  // namespace
@@ -47,62 +143,75 @@ UpdateOutcome KalmanUpdate(FilterState& s, const Eigen::Matrix<double, M, kState
 void InjectError(FilterState& s, const Eigen::Matrix<double, kStateDim, 1>& dx) {
   s.p += dx.segment<3>(kP);
   s.v += dx.segment<3>(kV);
-  s.q = (s.q * so3::ExpQuaternion(dx.segment<3>(kTheta))).normalized();
+  s.q = (s.q * ExpCorrection(dx.segment<3>(kTheta))).normalized();
   s.ba += dx.segment<3>(kBa);
   s.bg += dx.segment<3>(kBg);
   for (int i = 0; i < kMaxClones; ++i) {
     CloneSlot& c = s.clones[static_cast<size_t>(i)];
     if (c.id == kNoClone) continue;
     c.p_frame_imu += dx.segment<3>(CloneIndex(i));
-    c.q_frame_imu = (c.q_frame_imu * so3::ExpQuaternion(dx.segment<3>(CloneIndex(i) + 3))).normalized();
+    c.q_frame_imu = (c.q_frame_imu * ExpCorrection(dx.segment<3>(CloneIndex(i) + 3))).normalized();
   }
 }
 
-namespace {
-
-// Prediction and Jacobian of a relative pose between two clones.
-void RelativePoseModel(const FilterState& s, const RelativePoseMeasurement& m, Eigen::Vector3d* t_hat,
-                       Eigen::Quaterniond* q_hat, Eigen::Matrix<double, 6, kStateDim>* H) {
-  const CloneSlot& k = s.clones[static_cast<size_t>(m.keyframe_slot)];
-  const CloneSlot& c = s.clones[static_cast<size_t>(m.current_slot)];
-  const Eigen::Matrix3d Rk = k.q_frame_imu.toRotationMatrix();
-  *t_hat = Rk.transpose() * (c.p_frame_imu - k.p_frame_imu);
-  *q_hat = k.q_frame_imu.conjugate() * c.q_frame_imu;
-  const Eigen::Matrix3d R_rel = q_hat->toRotationMatrix();
-  H->setZero();
-  const int ik = CloneIndex(m.keyframe_slot);
-  const int ic = CloneIndex(m.current_slot);
-  H->block<3, 3>(0, ik) = -Rk.transpose();
-  H->block<3, 3>(0, ik + 3) = so3::Skew(*t_hat);
-  H->block<3, 3>(0, ic) = Rk.transpose();
-  H->block<3, 3>(3, ik + 3) = -R_rel.transpose();
-  H->block<3, 3>(3, ic + 3) = Eigen::Matrix3d::Identity();
-}
-
-}  // namespace
-
-Matrix6d RelativePoseCovariance(const FilterState& state, const RelativePoseMeasurement& m) {
-  FilterState s = state;  // a copy: the deferred cross-covariance must be applied
-  MaterializeCovariance(s);
+Matrix6d RelativePoseCovariance(const FilterState& s, const RelativePoseMeasurement& m) {
   Eigen::Vector3d t_hat;
   Eigen::Quaterniond q_hat;
-  Eigen::Matrix<double, 6, kStateDim> H;
-  RelativePoseModel(s, m, &t_hat, &q_hat, &H);
-  return H * s.P * H.transpose();
+  Matrix6d Hk, Hc;
+  RelativePoseModel(s, m, &t_hat, &q_hat, &Hk, &Hc);
+  const Matrix6d Pkk = CloneBlock(s, m.keyframe_slot, m.keyframe_slot);
+  const Matrix6d Pkc = CloneBlock(s, m.keyframe_slot, m.current_slot);
+  const Matrix6d Pcc = CloneBlock(s, m.current_slot, m.current_slot);
+  return Hk * Pkk * Hk.transpose() + Hk * Pkc * Hc.transpose() + Hc * Pkc.transpose() * Hk.transpose() +
+         Hc * Pcc * Hc.transpose();
 }
 
 UpdateOutcome ApplyRelativePoseUpdate(FilterState& s, const RelativePoseMeasurement& m, double gate) {
   Eigen::Vector3d t_hat;
   Eigen::Quaterniond q_hat;
-  Eigen::Matrix<double, 6, kStateDim> H;
-  RelativePoseModel(s, m, &t_hat, &q_hat, &H);
+  Matrix6d Hk, Hc;
+  RelativePoseModel(s, m, &t_hat, &q_hat, &Hk, &Hc);
   Eigen::Matrix<double, 6, 1> r;
   r.head<3>() = m.t_k_c - t_hat;
   r.tail<3>() = so3::Log(q_hat.conjugate() * m.q_k_c);
-  MaterializeCovariance(s);
-  const Eigen::Matrix<double, kStateDim, 6> PHt =
-      ClonePHt(s, H, CloneIndex(m.keyframe_slot), CloneIndex(m.current_slot));
-  return KalmanUpdate<6>(s, H, PHt, r, m.covariance, gate);
+
+  // H is zero outside the two clone blocks: P H^T from their column blocks.
+  MaterializeCross(s);
+  const int ik = CloneIndex(m.keyframe_slot), ic = CloneIndex(m.current_slot);
+  Eigen::Matrix<double, kStateDim, 6> U;
+  {
+    const Eigen::Matrix<double, kStateDim, 6> Ck = CloneColumns(s, m.keyframe_slot);
+    const Eigen::Matrix<double, kStateDim, 6> Cc = CloneColumns(s, m.current_slot);
+    const Matrix6d Hk_t = Hk.transpose(), Hc_t = Hc.transpose();
+    kernels::MulRows<6, 6, kernels::kSet>(U.data(), kStateDim, Ck.data(), kStateDim, kStateDim, Hk_t.data(), 6);
+    kernels::MulRows<6, 6, kernels::kAdd>(U.data(), kStateDim, Cc.data(), kStateDim, kStateDim, Hc_t.data(), 6);
+  }
+  Matrix6d S = m.covariance;
+  S += Hk.lazyProduct(U.middleRows<6>(ik)) + Hc.lazyProduct(U.middleRows<6>(ic));
+  S = 0.5 * (S + S.transpose()).eval();
+  const Eigen::LLT<Matrix6d> llt(S);
+  if (llt.info() != Eigen::Success) return UpdateOutcome::kBadCovariance;
+  if (gate > 0.0 && r.dot(llt.solve(r)) > gate) return UpdateOutcome::kGated;
+
+  // W = P H^T L^-T; P <- P - W W^T on the core block, the (bottom-left) cross block and the
+  // current part of the clone block; dx = W L^-1 r.
+  const Matrix6d L = llt.matrixL();
+  SolveLowerTransposedRight<kStateDim, 6>(L, U);
+  const Eigen::Matrix<double, kStateDim, 6>& W = U;
+  Eigen::Matrix<double, 6, 1> z = r;
+  SolveLower<6>(L, z);
+  const Eigen::Matrix<double, kStateDim, 1> dx = W.lazyProduct(z);
+  const Eigen::Matrix<double, 6, kCoreDim> Wc_t = W.topRows<kCoreDim>().transpose();
+  const Eigen::Matrix<double, kCloneDims, 6> Wx = W.bottomRows<kCloneDims>();
+  CoreMatrix core = s.P.topLeftCorner<kCoreDim, kCoreDim>();
+  core -= Wc_t.transpose().lazyProduct(Wc_t);
+  s.P.topLeftCorner<kCoreDim, kCoreDim>() = 0.5 * (core + core.transpose());
+  kernels::MulRowsWide<6, kCoreDim, kernels::kSub>(&s.P(kCoreDim, 0), kStateDim, Wx.data(), kCloneDims, kCloneDims,
+                                                   Wc_t.data(), 6);
+  SubtractCloneOuter<6>(s, Wx);
+  s.cross_pending = true;
+  InjectError(s, dx);
+  return UpdateOutcome::kApplied;
 }
 
 UpdateOutcome ApplyBodyVelocityUpdate(FilterState& s, const Eigen::Matrix3d& R_imu_meas,
@@ -115,29 +224,25 @@ UpdateOutcome ApplyBodyVelocityUpdate(FilterState& s, const Eigen::Matrix3d& R_i
   const Eigen::Vector3d w = s.gyro - s.bg;
   const Eigen::Vector3d v_imu = R.transpose() * s.v;
   const Eigen::Vector3d predicted = A * (v_imu + w.cross(p_imu_point));
-  Eigen::Matrix<double, 3, kStateDim> H3 = Eigen::Matrix<double, 3, kStateDim>::Zero();
+  Eigen::Matrix<double, 3, kCoreDim> H3 = Eigen::Matrix<double, 3, kCoreDim>::Zero();
   H3.block<3, 3>(0, kV) = A * R.transpose();
   H3.block<3, 3>(0, kTheta) = A * so3::Skew(v_imu);
   H3.block<3, 3>(0, kBg) = A * so3::Skew(p_imu_point);
   const Eigen::Vector3d r3 = velocity - predicted;
-  MaterializeCovariance(s);
   if (rows == 2) {
-    const Eigen::Matrix<double, 2, kStateDim> H2 = H3.topRows<2>();
-    return KalmanUpdate<2>(s, H2, CorePHt<2>(s, H2), r3.head<2>(), cov.topLeftCorner<2, 2>(), 0.0);
+    return CoreUpdate<2>(s, H3.topRows<2>(), r3.head<2>(), cov.topLeftCorner<2, 2>(), 0.0);
   }
   if (rows == 1) {
-    const Eigen::Matrix<double, 1, kStateDim> H1 = H3.topRows<1>();
-    return KalmanUpdate<1>(s, H1, CorePHt<1>(s, H1), r3.head<1>(), cov.topLeftCorner<1, 1>(), 0.0);
+    return CoreUpdate<1>(s, H3.topRows<1>(), r3.head<1>(), cov.topLeftCorner<1, 1>(), 0.0);
   }
-  return KalmanUpdate<3>(s, H3, CorePHt<3>(s, H3), r3, cov, 0.0);
+  return CoreUpdate<3>(s, H3, r3, cov, 0.0);
 }
 
 UpdateOutcome ApplyPositionUpdate(FilterState& s, const Eigen::Vector3d& p,
                                   const Eigen::Matrix3d& cov) {
-  Eigen::Matrix<double, 3, kStateDim> H = Eigen::Matrix<double, 3, kStateDim>::Zero();
+  Eigen::Matrix<double, 3, kCoreDim> H = Eigen::Matrix<double, 3, kCoreDim>::Zero();
   H.block<3, 3>(0, kP).setIdentity();
-  MaterializeCovariance(s);
-  return KalmanUpdate<3>(s, H, CorePHt<3>(s, H), Eigen::Vector3d(p - s.p), cov, 0.0);
+  return CoreUpdate<3>(s, H, Eigen::Vector3d(p - s.p), cov, 0.0);
 }
 
 }  // namespace cairn

@@ -1,14 +1,48 @@
 #include "estimation/frame_switch.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "estimation/so3.h"
 
 namespace cairn {
+namespace {
+
+// The Jacobian of the frame change is sparse: each 3-row block has at most three non-zero 3x3
+// blocks. Rows are addressed in units of 3 (core p, v, theta, ba, bg, then clone p, theta).
+constexpr int kRowBlocks = kStateDim / 3;
+
+struct SparseRowBlock {
+  int n = 0;  // 0: identity row block
+  std::array<int, 3> col{};
+  std::array<Eigen::Matrix3d, 3> m;
+  void Add(int c, const Eigen::Matrix3d& v) {
+    col[static_cast<size_t>(n)] = c;
+    m[static_cast<size_t>(n)] = v;
+    ++n;
+  }
+};
+
+// out = J x for a matrix with kStateDim rows.
+void ApplyRows(const std::array<SparseRowBlock, kRowBlocks>& J, const StateCovariance& x, StateCovariance& out) {
+  for (int b = 0; b < kRowBlocks; ++b) {
+    const SparseRowBlock& r = J[static_cast<size_t>(b)];
+    if (r.n == 0) {
+      out.middleRows<3>(3 * b) = x.middleRows<3>(3 * b);
+      continue;
+    }
+    out.middleRows<3>(3 * b).noalias() = r.m[0] * x.middleRows<3>(3 * r.col[0]);
+    for (int k = 1; k < r.n; ++k) {
+      out.middleRows<3>(3 * b).noalias() += r.m[static_cast<size_t>(k)] * x.middleRows<3>(3 * r.col[static_cast<size_t>(k)]);
+    }
+  }
+}
+
+}  // namespace
 
 FrameTransform SwitchFrame(FilterState& s, const Eigen::Isometry3d& T_imu_body,
-                           StateCovariance& J, StateCovariance& JP) {
+                           StateCovariance& JP, StateCovariance& scratch) {
   MaterializeCovariance(s);
   const Eigen::Matrix3d R = s.q.toRotationMatrix();
   const Eigen::Vector3d t_ib = T_imu_body.translation();
@@ -28,37 +62,39 @@ FrameTransform SwitchFrame(FilterState& s, const Eigen::Isometry3d& T_imu_body,
   const Eigen::Matrix3d ez = so3::Skew(Eigen::Vector3d::UnitZ());
   const Eigen::Matrix3d lever_theta = so3::Skew(lever) * R;  // d(p - p_o)/d dtheta
 
-  J.setIdentity();
-  J.block<3, 3>(kP, kP).setZero();
-  J.block<3, 3>(kP, kTheta) = C * lever_theta + C * ez * lever * y;
-  J.block<3, 3>(kV, kV) = C;
-  J.block<3, 3>(kV, kTheta) = -C * ez * s.v * y;
-  J.block<3, 3>(kTheta, kTheta) -= R.transpose() * Eigen::Vector3d::UnitZ() * y;
+  constexpr int bp = kP / 3, bv = kV / 3, bt = kTheta / 3;
+  std::array<SparseRowBlock, kRowBlocks> J{};
+  J[bp].Add(bt, C * lever_theta + C * ez * lever * y);  // the position error becomes zero
+  J[bv].Add(bv, C);
+  J[bv].Add(bt, -C * ez * s.v * y);
+  J[bt].Add(bt, Eigen::Matrix3d::Identity() - R.transpose() * Eigen::Vector3d::UnitZ() * y);
   for (int i = 0; i < kMaxClones; ++i) {
-    CloneSlot& c = s.clones[static_cast<size_t>(i)];
+    const CloneSlot& c = s.clones[static_cast<size_t>(i)];
     if (c.id == kNoClone) continue;
-    const int ic = CloneIndex(i);
-    J.block<3, 3>(ic, ic) = C;
-    J.block<3, 3>(ic, kP) = -C;
-    J.block<3, 3>(ic, kTheta) = C * lever_theta - C * ez * (c.p_frame_imu - p_o) * y;
-    J.block<3, 3>(ic + 3, kTheta) =
-        -(c.q_frame_imu.toRotationMatrix().transpose() * Eigen::Vector3d::UnitZ()) * y;
+    const int b = CloneIndex(i) / 3;
+    J[static_cast<size_t>(b)].Add(b, C);
+    J[static_cast<size_t>(b)].Add(bp, -C);
+    J[static_cast<size_t>(b)].Add(bt, C * lever_theta - C * ez * (c.p_frame_imu - p_o) * y);
+    J[static_cast<size_t>(b + 1)].Add(b + 1, Eigen::Matrix3d::Identity());
+    J[static_cast<size_t>(b + 1)].Add(bt, -(c.q_frame_imu.toRotationMatrix().transpose() * Eigen::Vector3d::UnitZ()) * y);
   }
 
   FrameTransform out;
-  Eigen::Matrix<double, 6, kStateDim> G = Eigen::Matrix<double, 6, kStateDim>::Zero();
+  Eigen::Matrix<double, 6, kCoreDim> G = Eigen::Matrix<double, 6, kCoreDim>::Zero();
   G.block<3, 3>(0, kP).setIdentity();
   G.block<3, 3>(0, kTheta) = -lever_theta;
   G.block<3, 3>(3, kTheta) = Eigen::Vector3d::UnitZ() * y;
-  const Eigen::Matrix<double, 6, kStateDim> GP = G * s.P;
+  const Eigen::Matrix<double, 6, kCoreDim> GP = G * s.P.topLeftCorner<kCoreDim, kCoreDim>();
   out.covariance.noalias() = GP * G.transpose();
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
   out.T_old_new.linear() = Rz;
   out.T_old_new.translation() = p_o;
 
-  JP.noalias() = J * s.P;
-  s.P.noalias() = JP * J.transpose();
-  s.P = 0.5 * (s.P + s.P.transpose()).eval();
+  // P <- J P J^T = J (J P)^T.
+  ApplyRows(J, s.P, JP);
+  scratch = JP.transpose();
+  ApplyRows(J, scratch, JP);
+  s.P = 0.5 * (JP + JP.transpose());
 
   const Eigen::Quaterniond qz_inv(C);
   s.p = C * (s.p - p_o);

@@ -1,28 +1,85 @@
 #include "estimation/imu_propagator.h"
 
+#include <cmath>
+#include <cstddef>
+
+#include "estimation/filter_kernels.h"
 #include "estimation/so3.h"
 
 namespace cairn {
 namespace {
 
-// The non-trivial 3x3 blocks of the 15x15 transition matrix Phi.
+// The transition matrix Phi of the 15-dim core error state, by its non-trivial blocks:
+//   dp' = dp + dt dv + dt/2 Fva (a x dtheta + dba)
+//   dv' = dv + Fva (a x dtheta + dba)                  Fva = -R_mid dt
+//   dtheta' = Ftt dtheta + Ftg dbg                     Ftt = Exp(w dt)^T, Ftg = -Jr(w dt) dt
+//   dba' = dba, dbg' = dbg
 struct Transition {
   double dt = 0.0;
-  Eigen::Matrix3d p_theta, p_ba, v_theta, v_ba, theta_theta, theta_bg;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // mean bias-corrected specific force (IMU frame)
+  Eigen::Matrix3d Fva, Ftt, Ftg;
 };
 
-// X <- Phi * X for a matrix with 15 rows, in place. The row blocks are updated in the order
-// p, v, theta so that each only reads blocks not yet overwritten.
-template <int Cols>
-void ApplyTransitionRows(const Transition& f, Eigen::Matrix<double, kCoreDim, Cols>& x) {
-  using Rows = Eigen::Matrix<double, 3, Cols>;
-  const Rows v = x.template middleRows<3>(kV);
-  const Rows th = x.template middleRows<3>(kTheta);
-  const Rows ba = x.template middleRows<3>(kBa);
-  const Rows bg = x.template middleRows<3>(kBg);
-  x.template middleRows<3>(kP).noalias() += f.dt * v + f.p_theta * th + f.p_ba * ba;
-  x.template middleRows<3>(kV).noalias() += f.v_theta * th + f.v_ba * ba;
-  x.template middleRows<3>(kTheta).noalias() = f.theta_theta * th + f.theta_bg * bg;
+// M <- M Phi^T for a column-major matrix M with `Rows` rows and 15 columns (leading dimension
+// ld): each row is one error vector, so the work is a few axpy over contiguous columns, done two
+// rows at a time. Applied to the transpose of a matrix, this is the left-multiplication Phi X.
+template <typename T>
+inline void TransitionRow(const Transition& f, T* const* col, int i) {
+  using kernels::Load;
+  (void)i;
+  const double a0 = f.a.x(), a1 = f.a.y(), a2 = f.a.z();
+  const Eigen::Matrix3d& F = f.Fva;
+  const Eigen::Matrix3d& R = f.Ftt;
+  const Eigen::Matrix3d& G = f.Ftg;
+  const T th0 = *col[6], th1 = *col[7], th2 = *col[8];
+  const T z0 = a1 * th2 - a2 * th1 + *col[9];
+  const T z1 = a2 * th0 - a0 * th2 + *col[10];
+  const T z2 = a0 * th1 - a1 * th0 + *col[11];
+  const T g0 = *col[12], g1 = *col[13], g2 = *col[14];
+  *col[6] = R(0, 0) * th0 + R(0, 1) * th1 + R(0, 2) * th2 + G(0, 0) * g0 + G(0, 1) * g1 + G(0, 2) * g2;
+  *col[7] = R(1, 0) * th0 + R(1, 1) * th1 + R(1, 2) * th2 + G(1, 0) * g0 + G(1, 1) * g1 + G(1, 2) * g2;
+  *col[8] = R(2, 0) * th0 + R(2, 1) * th1 + R(2, 2) * th2 + G(2, 0) * g0 + G(2, 1) * g1 + G(2, 2) * g2;
+  const T d0 = F(0, 0) * z0 + F(0, 1) * z1 + F(0, 2) * z2;
+  const T d1 = F(1, 0) * z0 + F(1, 1) * z1 + F(1, 2) * z2;
+  const T d2 = F(2, 0) * z0 + F(2, 1) * z1 + F(2, 2) * z2;
+  const double dt = f.dt, hdt = 0.5 * f.dt;
+  *col[0] = *col[0] + dt * *col[3] + hdt * d0;
+  *col[1] = *col[1] + dt * *col[4] + hdt * d1;
+  *col[2] = *col[2] + dt * *col[5] + hdt * d2;
+  *col[3] = *col[3] + d0;
+  *col[4] = *col[4] + d1;
+  *col[5] = *col[5] + d2;
+}
+
+template <int Rows>
+void ApplyTransitionT(const Transition& f, double* m, int ld) {
+  using kernels::V2;
+  int i = 0;
+  for (; i + 2 <= Rows; i += 2) {
+    V2 v[kCoreDim];
+    for (int c = 0; c < kCoreDim; ++c) v[c] = kernels::Load(m + static_cast<ptrdiff_t>(c) * ld + i);
+    V2* col[kCoreDim];
+    for (int c = 0; c < kCoreDim; ++c) col[c] = &v[c];
+    TransitionRow<V2>(f, col, i);
+    for (int c = 0; c < 9; ++c) kernels::Store(m + static_cast<ptrdiff_t>(c) * ld + i, v[c]);
+  }
+  if constexpr (Rows % 2 == 1) {
+    double* col[kCoreDim];
+    for (int c = 0; c < kCoreDim; ++c) col[c] = m + static_cast<ptrdiff_t>(c) * ld + i;
+    TransitionRow<double>(f, col, i);
+  }
+}
+
+// Jr(phi) from the rotation's half-angle sine and cosine (no further trigonometry).
+Eigen::Matrix3d RightJacobianFromHalfAngle(const Eigen::Vector3d& phi, double s_half, double c_half) {
+  const double theta2 = phi.squaredNorm();
+  const Eigen::Matrix3d W = so3::Skew(phi);
+  if (theta2 < 1e-10) return Eigen::Matrix3d::Identity() - 0.5 * W + W * W / 6.0;
+  const double theta = std::sqrt(theta2);
+  const double one_minus_cos = 2.0 * s_half * s_half;
+  const double sin_theta = 2.0 * s_half * c_half;
+  return Eigen::Matrix3d::Identity() - one_minus_cos / theta2 * W +
+         (theta - sin_theta) / (theta2 * theta) * W * W;
 }
 
 }  // namespace
@@ -43,32 +100,38 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   const Eigen::Matrix3d R0 = s.q.toRotationMatrix();
   const Eigen::Vector3d phi = w * dt;
   const Eigen::Quaterniond dq = so3::ExpQuaternion(phi);
-  const Eigen::Quaterniond q1 = (s.q * dq).normalized();
+  const Eigen::Quaterniond q0 = s.q;
+  const Eigen::Quaterniond q1 = (q0 * dq).normalized();
   const Eigen::Matrix3d R1 = q1.toRotationMatrix();
   const Eigen::Vector3d acc_world = 0.5 * (R0 * a0 + R1 * a1) + gravity_;
   s.p += s.v * dt + 0.5 * acc_world * dt * dt;
   s.v += acc_world * dt;
   s.q = q1;
 
-  // Error transition, linearized about the mid-interval attitude and mean specific force.
-  const Eigen::Matrix3d R_mid = (s.q.slerp(0.5, Eigen::Quaterniond(R0))).toRotationMatrix();
-  const Eigen::Vector3d a_mean = 0.5 * (a0 + a1);
+  // Error transition, linearized about the mid-interval attitude q0 Exp(phi / 2) (the geodesic
+  // midpoint, from dq by the half-angle formulas) and the mean specific force.
+  const double c_half = dq.w();           // cos(|phi| / 2), dq is normalized with w >= 0
+  const double s_half = dq.vec().norm();  // sin(|phi| / 2)
+  const double c_quarter = std::sqrt(0.5 * (1.0 + c_half));
+  const Eigen::Quaterniond dq_mid(c_quarter, 0.5 / c_quarter * dq.x(), 0.5 / c_quarter * dq.y(),
+                                  0.5 / c_quarter * dq.z());
+  const Eigen::Matrix3d R_mid = (q0 * dq_mid).normalized().toRotationMatrix();
   Transition f;
   f.dt = dt;
-  f.v_theta = -R_mid * so3::Skew(a_mean) * dt;
-  f.v_ba = -R_mid * dt;
-  f.p_theta = 0.5 * dt * f.v_theta;
-  f.p_ba = 0.5 * dt * f.v_ba;
-  f.theta_theta = dq.toRotationMatrix().transpose();
-  f.theta_bg = -so3::RightJacobian(phi) * dt;
+  f.a = 0.5 * (a0 + a1);
+  f.Fva = -dt * R_mid;
+  f.Ftt = dq.toRotationMatrix().transpose();
+  f.Ftg = -dt * RightJacobianFromHalfAngle(phi, s_half, c_half);
 
-  // P_core <- Phi P_core Phi^T + Q; the cross block with the clones is deferred (phi <- Phi phi).
-  Eigen::Matrix<double, kCoreDim, kCoreDim> half = s.P.topLeftCorner<kCoreDim, kCoreDim>();
-  ApplyTransitionRows(f, half);
-  Eigen::Matrix<double, kCoreDim, kCoreDim> core = half.transpose();
-  ApplyTransitionRows(f, core);
-  ApplyTransitionRows(f, s.phi);
-  s.cross_pending = true;
+  // P_core <- Phi P_core Phi^T + Q: with P_core symmetric, Y^T = P_core Phi^T and then
+  // Phi P_core Phi^T = Y Phi^T.
+  Eigen::Matrix<double, kCoreDim, kCoreDim> Yt = s.P.topLeftCorner<kCoreDim, kCoreDim>();
+  ApplyTransitionT<kCoreDim>(f, Yt.data(), kCoreDim);
+  Eigen::Matrix<double, kCoreDim, kCoreDim> core = Yt.transpose();
+  // Only rows p, v, theta are needed (the bias rows follow by symmetry from the bias columns,
+  // which Phi^T leaves unchanged).
+  ApplyTransitionT<9>(f, core.data(), kCoreDim);
+  core.bottomRows<6>() = core.rightCols<6>().transpose().eval();
 
   const double qa = noise_.accel_noise_density * noise_.accel_noise_density;
   const double qg = noise_.gyro_noise_density * noise_.gyro_noise_density;
@@ -83,6 +146,17 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   core.block<3, 3>(kBa, kBa).diagonal().array() += qba * dt;
   core.block<3, 3>(kBg, kBg).diagonal().array() += qbg * dt;
   s.P.topLeftCorner<kCoreDim, kCoreDim>() = 0.5 * (core + core.transpose());
+
+  // Cross-covariance with the clones: X <- Phi X, deferred in phi (phi <- Phi phi; phi is
+  // row-major, so its storage is phi^T) except for the clones whose cross block is kept current
+  // (stored transposed, B_j <- B_j Phi^T).
+  ApplyTransitionT<kCoreDim>(f, s.phi.data(), kCoreDim);
+  for (int j = 0; j < kMaxClones; ++j) {
+    const size_t u = static_cast<size_t>(j);
+    if (s.clones[u].id == kNoClone || !s.cross_current[u]) continue;
+    ApplyTransitionT<6>(f, &s.P(CloneIndex(j), 0), kStateDim);
+  }
+  s.cross_pending = true;
 
   s.time = t1;
   s.accel = accel1;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "estimation/filter_kernels.h"
 #include "estimation/filter_update.h"
 #include "estimation/so3.h"
 #include "estimation/wheel_velocity.h"
@@ -82,6 +83,7 @@ void LocalReferenceFilter::Initialize(Timestamp time, const Eigen::Vector3d& p,
   state_.clones.fill(CloneSlot{});
   state_.P.setZero();
   state_.phi.setIdentity();
+  state_.cross_current.fill(false);
   state_.cross_pending = false;
   state_.P.topLeftCorner<15, 15>() = 0.5 * (covariance + covariance.transpose());
   initialized_ = true;
@@ -325,12 +327,13 @@ int LocalReferenceFilter::active_clones() const {
 }
 
 void LocalReferenceFilter::Marginalize(int slot) {
-  // Dropping a clone's rows and columns is exact marginalization of a Gaussian.
-  MaterializeCovariance(state_);
+  // Dropping a clone's rows and columns is exact marginalization of a Gaussian; it needs nothing
+  // deferred to be applied (the slot's cross block is zero in any representation).
   const int ic = CloneIndex(slot);
   state_.P.middleRows<6>(ic).setZero();
   state_.P.middleCols<6>(ic).setZero();
   state_.clones[static_cast<size_t>(slot)] = CloneSlot{};
+  state_.cross_current[static_cast<size_t>(slot)] = false;
   if (!replaying_) ++counters_.clones_marginalized;
 }
 
@@ -350,21 +353,61 @@ void LocalReferenceFilter::AddClone(CloneId id) {
     }
     Marginalize(victim);
   }
+  // Clones whose cross block is kept current cost work per IMU sample: bound their number.
+  int current = 0;
+  for (int i = 0; i < kMaxClones; ++i) current += state_.cross_current[static_cast<size_t>(i)] ? 1 : 0;
+  if (current >= kMaxCurrentCrossBlocks) MaterializeCross(state_);
+
   int slot = 0;
   while (state_.clones[static_cast<size_t>(slot)].id != kNoClone) ++slot;
+  // The clone's error equals the current pose error [dp, dtheta]: its covariance with the core
+  // is the core's p and theta rows, with another clone the p and theta columns of that clone's
+  // clone-core cross block.
+  const int ic = CloneIndex(slot);
+  state_.P.block<3, kCoreDim>(ic, 0) = state_.P.block<3, kCoreDim>(kP, 0);
+  state_.P.block<3, kCoreDim>(ic + 3, 0) = state_.P.block<3, kCoreDim>(kTheta, 0);
+  // Covariances of all clones with the new one: the p and theta columns of their true
+  // clone-core cross blocks, B phi^T (or B where it is current).
+  Eigen::Matrix<double, kCoreDim, 6> pose_cols_phi_t;  // columns p, theta of phi^T
+  pose_cols_phi_t.leftCols<3>() = state_.phi.middleRows<3>(kP).transpose();
+  pose_cols_phi_t.rightCols<3>() = state_.phi.middleRows<3>(kTheta).transpose();
+  constexpr int kCloneDims = kStateDim - kCoreDim;
+  Eigen::Matrix<double, kCloneDims, 6> with_new;
+  kernels::MulRows<kCoreDim, 6, kernels::kSet>(with_new.data(), kCloneDims, &state_.P(kCoreDim, 0), kStateDim,
+                                               kCloneDims, pose_cols_phi_t.data(), kCoreDim);
+  for (int j = 0; j < kMaxClones; ++j) {
+    if (j == slot || state_.clones[static_cast<size_t>(j)].id == kNoClone) continue;
+    const int jc = CloneIndex(j);
+    Matrix6d b;  // covariance of clone j with the new clone
+    if (state_.cross_current[static_cast<size_t>(j)]) {
+      const auto B = state_.P.block<6, kCoreDim>(jc, 0);
+      b.leftCols<3>() = B.middleCols<3>(kP);
+      b.rightCols<3>() = B.middleCols<3>(kTheta);
+    } else {
+      b = with_new.middleRows<6>(6 * j);
+    }
+    // Only the blocks on and below the block diagonal are kept current.
+    if (j > slot) {
+      state_.P.block<6, 6>(jc, ic) = b;
+    } else {
+      state_.P.block<6, 6>(ic, jc) = b.transpose();
+    }
+  }
+  Matrix6d d;
+  d.topLeftCorner<3, 3>() = state_.P.block<3, 3>(kP, kP);
+  d.topRightCorner<3, 3>() = state_.P.block<3, 3>(kP, kTheta);
+  d.bottomLeftCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kP);
+  d.bottomRightCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kTheta);
+  state_.P.block<6, 6>(ic, ic) = d;
+  state_.cross_current[static_cast<size_t>(slot)] = true;
+  state_.cross_pending = true;
+
   CloneSlot& c = state_.clones[static_cast<size_t>(slot)];
   c.id = id;
   c.time = state_.time;
   c.p_frame_imu = state_.p;
   c.q_frame_imu = state_.q;
   c.last_used = state_.time;
-  // The clone's error equals the current pose error: copy those rows, then those columns.
-  MaterializeCovariance(state_);
-  const int ic = CloneIndex(slot);
-  state_.P.middleRows<3>(ic) = state_.P.middleRows<3>(kP);
-  state_.P.middleRows<3>(ic + 3) = state_.P.middleRows<3>(kTheta);
-  state_.P.middleCols<3>(ic) = state_.P.middleCols<3>(kP);
-  state_.P.middleCols<3>(ic + 3) = state_.P.middleCols<3>(kTheta);
 }
 
 void LocalReferenceFilter::PushSnapshot(uint64_t imu_seq) {

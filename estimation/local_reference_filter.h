@@ -114,6 +114,10 @@ struct FrameSwitchResult {
 
 class LocalReferenceFilter {
  public:
+  // Clones whose core-clone cross-covariance is propagated with every IMU sample instead of being
+  // deferred (the clones made since the last relative-pose update); more are folded back first.
+  static constexpr int kMaxCurrentCrossBlocks = 6;
+
   LocalReferenceFilter(const FilterOptions& options, const ImuCalibration& imu,
                        const WheelCalibration& wheels = WheelCalibration{});
 

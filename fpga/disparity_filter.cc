@@ -4,8 +4,14 @@
 #include <cstdlib>
 
 #include "fpga/stereo_matcher_interface.h"
+#include "fpga/worker_pool.h"
 
 namespace cairn {
+
+// The interior pixels [x0, x1) of a row in SIMD vectors (disparity_filter_simd.cc); returns
+// where the scalar loop has to continue.
+int MedianInteriorRow(const int16_t* u, const int16_t* c, const int16_t* d, int16_t* o, int x0,
+                      int x1);
 
 namespace {
 
@@ -44,10 +50,11 @@ void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int 
     }
     const int16_t* u = c - width;
     const int16_t* d = c + width;
+    const int x_simd = MedianInteriorRow(u, c, d, o, 1, width - 1);
     // Interior: a branch-free odd-even transposition sort of the 9 values (9 rounds sort 9
     // inputs), vectorized by the compiler. kInvalidDisparity is the smallest int16, so the
     // invalid values come first and the median of the n valid ones sits at 9 - n + (n - 1) / 2.
-    for (int x = 1; x < width - 1; ++x) {
+    for (int x = x_simd; x < width - 1; ++x) {
       int16_t p0 = u[x - 1], p1 = u[x], p2 = u[x + 1], p3 = c[x - 1], p4 = c[x], p5 = c[x + 1],
               p6 = d[x - 1], p7 = d[x], p8 = d[x + 1];
       const int16_t centre = p4;
@@ -89,44 +96,150 @@ void DisparityFilter::Median3x3(const int16_t* in, int16_t* out, int width, int 
   }
 }
 
-void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, int max_size,
-                                     int max_diff) {
-  if (max_size <= 0) return;
-  const size_t n = static_cast<size_t>(width) * height;
-  label_.assign(n, 0);  // no reallocation once the size was seen
-  stack_.resize(2 * n);  // (x, y) pairs: no division per visited pixel
-  region_.resize(n);
-  for (int sy = 0; sy < height; ++sy) {
-    for (int sx = 0; sx < width; ++sx) {
-      const size_t start = static_cast<size_t>(sy) * width + sx;
-      if (label_[start] != 0 || disparity[start] == kInvalidDisparity) continue;
+void DisparityFilter::FillBand(int16_t* disparity, int width, int height, int y0, int y1,
+                               int max_size, int max_diff, Band& band) {
+  const int rows = y1 - y0;
+  const int pw = width + 2;
+  const size_t cells = static_cast<size_t>(pw) * (rows + 2);
+  band.visited.resize(cells);
+  band.disparity.resize(cells);
+  band.stack.resize(static_cast<size_t>(rows) * width);
+  band.region.resize(static_cast<size_t>(rows) * width);
+  band.top_id.assign(static_cast<size_t>(width), 0);
+  band.bottom_id.assign(static_cast<size_t>(width), 0);
+  band.open.clear();
+  band.open_pixels.clear();
+  uint8_t* visited = band.visited.data();
+  int16_t* disp = band.disparity.data();
+  std::fill_n(visited, pw, uint8_t{1});
+  std::fill_n(visited + static_cast<size_t>(rows + 1) * pw, pw, uint8_t{1});
+  for (int r = 0; r < rows; ++r) {
+    const int16_t* src = disparity + static_cast<size_t>(y0 + r) * width;
+    uint8_t* v = visited + static_cast<size_t>(r + 1) * pw;
+    int16_t* d = disp + static_cast<size_t>(r + 1) * pw;
+    v[0] = v[width + 1] = 1;
+    d[0] = d[width + 1] = kInvalidDisparity;
+    for (int x = 0; x < width; ++x) {
+      d[x + 1] = src[x];
+      v[x + 1] = src[x] == kInvalidDisparity ? 1 : 0;
+    }
+  }
+  int32_t* stack = band.stack.data();
+  int32_t* region = band.region.data();
+  // Cells of the first and the last row of the band; they matter where another band follows.
+  const int32_t first_end = pw + width + 1, last_begin = rows * pw + 1;
+  const bool open_top = y0 > 0, open_bottom = y1 < height;
+  for (int r = 0; r < rows; ++r) {
+    for (int x = 0; x < width; ++x) {
+      const int32_t start = (r + 1) * pw + x + 1;
+      if (visited[start] != 0) continue;
       // Flood fill, remembering the members so that a small region can be cleared afterwards.
+      const int32_t id = (y0 + r) * width + x + 1;
       int top = 0, count = 0;
-      stack_[top++] = sx;
-      stack_[top++] = sy;
-      label_[start] = 1;
+      bool open = false;
+      stack[top++] = start;
+      visited[start] = 1;
       while (top > 0) {
-        const int py = stack_[--top];
-        const int px = stack_[--top];
-        const int32_t p = py * width + px;
-        region_[count++] = p;
-        const int16_t dp = disparity[p];
-        const auto visit = [&](int qx, int qy) {
-          const int32_t q = qy * width + qx;
-          if (label_[q] != 0) return;
-          const int16_t dq = disparity[q];
-          if (dq == kInvalidDisparity || std::abs(dq - dp) > max_diff) return;
-          label_[q] = 1;
-          stack_[top++] = qx;
-          stack_[top++] = qy;
-        };
-        if (px > 0) visit(px - 1, py);
-        if (px + 1 < width) visit(px + 1, py);
-        if (py > 0) visit(px, py - 1);
-        if (py + 1 < height) visit(px, py + 1);
+        const int32_t p = stack[--top];
+        region[count++] = p;
+        if (p < first_end) {
+          band.top_id[static_cast<size_t>(p - pw - 1)] = id;
+          open |= open_top;
+        }
+        if (p >= last_begin) {
+          band.bottom_id[static_cast<size_t>(p - last_begin)] = id;
+          open |= open_bottom;
+        }
+        const int dp = disp[p];
+        for (const int32_t q : {p - 1, p + 1, p - pw, p + pw}) {
+          if (visited[q] != 0 || std::abs(disp[q] - dp) > max_diff) continue;
+          visited[q] = 1;
+          stack[top++] = q;
+        }
       }
-      if (count < max_size) {
-        for (int i = 0; i < count; ++i) disparity[region_[i]] = kInvalidDisparity;
+      if (open) {
+        band.open.push_back({id, count, band.open_pixels.size()});
+        if (count < max_size) band.open_pixels.insert(band.open_pixels.end(), region, region + count);
+      } else if (count < max_size) {
+        for (int i = 0; i < count; ++i) {
+          const int32_t p = region[i];
+          const int py = p / pw - 1, px = p % pw - 1;  // only for the few cleared pixels
+          disparity[static_cast<size_t>(y0 + py) * width + px] = kInvalidDisparity;
+        }
+      }
+    }
+  }
+}
+
+void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, int max_size,
+                                     int max_diff, WorkerPool* pool) {
+  if (max_size <= 0) return;
+  // Bands of at least 32 rows, one per thread.
+  const int bands = std::max(1, std::min(pool != nullptr ? pool->threads() : 1, height / 32));
+  bands_.resize(static_cast<size_t>(bands));
+  const auto band_rows = [&](int b, int* y0, int* y1) {
+    *y0 = static_cast<int>(static_cast<int64_t>(height) * b / bands);
+    *y1 = static_cast<int>(static_cast<int64_t>(height) * (b + 1) / bands);
+  };
+  auto fill = [&](int b) {
+    int y0, y1;
+    band_rows(b, &y0, &y1);
+    FillBand(disparity, width, height, y0, y1, max_size, max_diff, bands_[static_cast<size_t>(b)]);
+  };
+  if (bands == 1) {
+    fill(0);
+    return;
+  }
+  pool->ForEach(bands, fill);
+  // Join the open regions across the band borders (union-find over their ids), then clear the
+  // joined regions that stay small.
+  std::vector<Open*> open;  // by index
+  for (Band& band : bands_) {
+    for (Open& o : band.open) open.push_back(&o);
+  }
+  std::sort(open.begin(), open.end(), [](const Open* a, const Open* b) { return a->id < b->id; });
+  const auto index_of = [&](int32_t id) {
+    const auto it = std::lower_bound(open.begin(), open.end(), id,
+                                     [](const Open* o, int32_t v) { return o->id < v; });
+    return static_cast<int32_t>(it - open.begin());
+  };
+  parent_.resize(open.size());
+  for (size_t i = 0; i < open.size(); ++i) parent_[i] = static_cast<int32_t>(i);
+  const auto find = [&](int32_t i) {
+    while (parent_[static_cast<size_t>(i)] != i) {
+      parent_[static_cast<size_t>(i)] = parent_[static_cast<size_t>(parent_[static_cast<size_t>(i)])];
+      i = parent_[static_cast<size_t>(i)];
+    }
+    return i;
+  };
+  std::vector<int64_t> size(open.size());
+  for (size_t i = 0; i < open.size(); ++i) size[i] = open[i]->size;
+  for (int b = 1; b < bands; ++b) {
+    int y0, y1;
+    band_rows(b, &y0, &y1);
+    const int32_t* above = bands_[static_cast<size_t>(b - 1)].bottom_id.data();
+    const int32_t* below = bands_[static_cast<size_t>(b)].top_id.data();
+    const int16_t* da = disparity + static_cast<size_t>(y0 - 1) * width;
+    const int16_t* db = disparity + static_cast<size_t>(y0) * width;
+    for (int x = 0; x < width; ++x) {
+      if (da[x] == kInvalidDisparity || db[x] == kInvalidDisparity) continue;
+      if (std::abs(da[x] - db[x]) > max_diff) continue;
+      const int32_t ra = find(index_of(above[x])), rb = find(index_of(below[x]));
+      if (ra == rb) continue;
+      parent_[static_cast<size_t>(rb)] = ra;
+      size[static_cast<size_t>(ra)] += size[static_cast<size_t>(rb)];
+    }
+  }
+  const int pw = width + 2;
+  for (int b = 0; b < bands; ++b) {
+    int y0, y1;
+    band_rows(b, &y0, &y1);
+    const Band& band = bands_[static_cast<size_t>(b)];
+    for (const Open& o : band.open) {
+      if (o.size >= max_size || size[static_cast<size_t>(find(index_of(o.id)))] >= max_size) continue;
+      for (int32_t i = 0; i < o.size; ++i) {
+        const int32_t p = band.open_pixels[o.first_pixel + i];
+        disparity[static_cast<size_t>(y0 + p / pw - 1) * width + p % pw - 1] = kInvalidDisparity;
       }
     }
   }

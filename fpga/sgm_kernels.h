@@ -14,6 +14,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "fpga/stereo_matcher_interface.h"
+
 namespace cairn {
 
 inline constexpr uint8_t kPathSentinel = 0xFF;
@@ -71,12 +73,67 @@ uint8_t SgmPathStep(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uin
                     uint8_t p2, int d_count, uint8_t* out);
 // Equiangular sub-pixel offset in 1/kDisparityScale px from the sums at the winner (`at`) and its
 // neighbours, rounded half away from zero; 0 when the denominator is 0.
-int SgmSubpixelOffset(int below, int at, int above);
+inline int SgmSubpixelOffset(int below, int at, int above) {
+  const int den = (below > above ? below : above) - at;
+  if (den <= 0) return 0;
+  const int num = (below - above) * (kDisparityScale / 2);
+  return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
 // The left-right check of a left winner k against the right image's winner at the match (-1 when
 // that right pixel had no candidate).
 inline bool SgmLeftRightConsistent(int k, int right_k, int max_diff) {
   return right_k >= 0 && (k > right_k ? k - right_k : right_k - k) <= max_diff;
 }
+// The SIMD backend's own schedule for the four horizontal and vertical paths
+// (SgmMatcher::MatchFourPath): fewer, fused passes, the same arithmetic as the kernels above.
+//
+// Cost inputs of one row. Both census rows are stored as `planes` = ceil(census bits / 4) nibble
+// planes: nibble b of the left census at x is left[b * left_stride + x], nibble b of the reversed
+// right census right(i) (see SgmKernels::cost) is nibbles[b * stride + i]. cost(x, k) is as in
+// SgmKernels::cost; pixels x in [safe_begin, safe_end) have no border lanes.
+struct SgmCostRow {
+  const uint8_t* left = nullptr;
+  int left_stride = 0;
+  const uint8_t* nibbles = nullptr;
+  int stride = 0;
+  int planes = 0;
+  const uint8_t* border = nullptr;
+  int safe_begin = 0, safe_end = 0;
+};
+
+// Path rows here are plain: width * D uint8, no sentinel blocks; every pointer is aligned to 64
+// bytes and has 64 readable bytes before and after.
+struct SgmFourPathKernels {
+  // One vertical path over a row, the cost computed on the fly: out = step(prev) as in
+  // SgmKernels::vertical with one path, out = cost where prev == nullptr (first row of the
+  // sweep); out_min[x] = min_k out(x, k); cost_out (may be null) receives the cost row.
+  void (*vertical)(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
+                   const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
+                   const uint8_t* prev, const uint8_t* prev_min, uint8_t* out, uint8_t* out_min,
+                   uint8_t* cost_out);
+  // A row of the second half, complete: its cost, the own vertical path (as `vertical`, prev ->
+  // out), both horizontal paths (as SgmKernels::horizontal), their sum with the opposite
+  // vertical path vb, and winner-take-all as SgmKernels::wta (best, right_best); offset[x] is the
+  // sub-pixel offset at best (SgmSubpixelOffset) with `subpixel` and 0 < best < D - 1, else 0.
+  // Sums are uint8 when `narrow` (the caller guarantees that four path costs stay <= 255), else
+  // uint16. threshold[m] = ceil(100 m / (100 - uniqueness_percent)) for every sum m. partial:
+  // width * D sums and cost: width * D bytes of scratch space; scratch: 4 D + 4 D + 64 bytes
+  // plus 8 (rev_base + D + 96) sums.
+  void (*finish_row)(const SgmCostRow& c, const SgmRowGeometry& g, const uint8_t* image_row,
+                     const uint8_t* prev_image_row, const uint8_t* p2_table, uint8_t p1,
+                     const uint8_t* prev, const uint8_t* prev_min, uint8_t* out,
+                     uint8_t* out_min, const uint8_t* vb, int uniqueness_percent, bool subpixel,
+                     bool narrow, void* partial, uint8_t* cost, const uint32_t* threshold,
+                     uint8_t* scratch, int16_t* best, int16_t* offset, int16_t* right_best);
+  // SgmKernels::census of one row, as SgmCostRow's nibble planes: plane b at out + b * stride,
+  // index x, or with `reversed` index width - 1 + pad - x (pad = max(0, -d_min)) and 0 elsewhere
+  // below n_rev = rev_base + D.
+  void (*census)(const uint8_t* center, ptrdiff_t stride, int width, int cw, int ch, uint8_t* out,
+                 int plane_stride, bool reversed, int pad, int n_rev);
+};
+// nullptr where the dispatched target has no such kernels (HWY_SCALAR).
+const SgmFourPathKernels* SimdFourPathKernels();
+
 // Highway implementation for the best target of this CPU (AVX2, SSE4, NEON, ...).
 const SgmKernels& SimdSgmKernels();
 // Name of the Highway target SimdSgmKernels() dispatches to, for reports.

@@ -52,6 +52,18 @@ SgmMatcher::SgmMatcher(const SgmOptions& options)
       rx_(static_cast<int>(options.census_width / 2)),
       ry_(static_cast<int>(options.census_height / 2)) {
   options.FillP2Table(p2_table_);
+  if (options.backend == SgmBackend::kSimd && options.paths == 4 && !options.raster_paths) {
+    four_path_ = SimdFourPathKernels();
+  }
+  // Four path costs of at most census_bits + p2 each (sgm_kernels.h) fit uint8 sums; the winner's
+  // index k has to fit them too.
+  narrow_sums_ = 4 * (options.census_bits() + options.p2) <= 255 && options.num_disparities <= 256;
+  // The uniqueness test "s (100 - u) < m 100" as "s < t(m)" for every possible sum m <= 4 * 255.
+  const uint32_t keep = static_cast<uint32_t>(100 - options.uniqueness_percent);
+  uniqueness_threshold_.resize(4 * 255 + 1);
+  for (uint32_t m = 0; m < uniqueness_threshold_.size(); ++m) {
+    uniqueness_threshold_[m] = (m * 100u + keep - 1) / keep;
+  }
 }
 
 std::string_view SgmMatcher::name() const {
@@ -80,9 +92,13 @@ void SgmMatcher::Allocate(int width, int height) {
   pad_right_ = AllocateBuffer<uint8_t>(pad_bytes, &buffer_bytes_);
   std::memset(pad_left_.get(), 0, pad_bytes);
   std::memset(pad_right_.get(), 0, pad_bytes);
-  census_left_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
-  census_right_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
-  if (!options_.raster_paths) {  // the raster pass needs no sum volume
+  if (four_path_ == nullptr) {  // the four-path schedule keeps its census as nibble planes
+    census_left_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+    census_right_ = AllocateBuffer<uint32_t>(w * h, &buffer_bytes_);
+  }
+  if (four_path_ != nullptr) {
+    AllocateFourPath();
+  } else if (!options_.raster_paths) {  // the raster pass needs no sum volume
     sum_ = AllocateBuffer<uint16_t>(w * h * d, &buffer_bytes_);
     AdviseHugePages(sum_.get(), w * h * d * sizeof(uint16_t));
   }
@@ -90,6 +106,7 @@ void SgmMatcher::Allocate(int width, int height) {
   filtered_ = AllocateBuffer<int16_t>(w * h, &buffer_bytes_);
   const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
   for (Sweep& s : sweeps_) {
+    if (four_path_ != nullptr) break;
     s.cost = AllocateBuffer<uint8_t>(w * d, &buffer_bytes_);
     s.row_sum = AllocateBuffer<uint16_t>(w * d, &buffer_bytes_);
     s.horizontal_scratch = AllocateBuffer<uint8_t>(kPathLead + 4 * geometry_.block, &buffer_bytes_);
@@ -108,6 +125,132 @@ void SgmMatcher::Allocate(int width, int height) {
     s.best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
     s.right_best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
   }
+}
+
+void SgmMatcher::AllocateFourPath() {
+  const size_t w = static_cast<size_t>(width_), h = static_cast<size_t>(height_);
+  const size_t d = static_cast<size_t>(geometry_.disparities);
+  const size_t row = w * d;
+  // 64 readable bytes before and after every path row (sgm_kernels.h).
+  volume_ = AllocateBuffer<uint8_t>(row * h + 128, &buffer_bytes_);
+  AdviseHugePages(volume_.get(), row * h + 128);
+  const size_t n_rev = static_cast<size_t>(geometry_.rev_base) + d + 64;
+  const size_t planes = static_cast<size_t>(nibble_planes());
+  nibbles_ = AllocateBuffer<uint8_t>(h * planes * static_cast<size_t>(nibble_stride()) + 64,
+                                     &buffer_bytes_);
+  left_nibbles_ = AllocateBuffer<uint8_t>(h * planes * w + 64, &buffer_bytes_);
+  // The right image sits at i in [pad, pad + width) (pad = max(0, -d_min)), the border cost
+  // around it.
+  border_ = AllocateBuffer<uint8_t>(n_rev, &buffer_bytes_);
+  const int pad = geometry_.rev_base - (width_ - 1) - geometry_.min_disparity;
+  std::fill_n(border_.get(), n_rev, static_cast<uint8_t>(options_.census_bits()));
+  std::fill_n(border_.get() + pad, w, uint8_t{0});
+  for (FourPathLane& l : lanes_) {
+    for (int b = 0; b < 2; ++b) {
+      l.state[b] = AllocateBuffer<uint8_t>(row + 128, &buffer_bytes_);
+      l.mins[b] = AllocateBuffer<uint8_t>(w, &buffer_bytes_);
+    }
+    l.partial = AllocateBuffer<uint8_t>(row * 2, &buffer_bytes_);
+    l.cost = AllocateBuffer<uint8_t>(row, &buffer_bytes_);
+    l.scratch = AllocateBuffer<uint8_t>(8 * d + 64 + 16 * (n_rev + 96), &buffer_bytes_);
+    l.best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
+    l.offset = AllocateBuffer<int16_t>(w, &buffer_bytes_);
+    l.right_best = AllocateBuffer<int16_t>(w, &buffer_bytes_);
+  }
+}
+
+SgmCostRow SgmMatcher::FourPathCostRow(int y) const {
+  const SgmRowGeometry& g = geometry_;
+  SgmCostRow c;
+  c.stride = nibble_stride();
+  c.planes = nibble_planes();
+  c.left_stride = width_;
+  c.left = left_nibbles_.get() + static_cast<size_t>(y) * c.planes * width_;
+  c.nibbles = nibbles_.get() + static_cast<size_t>(y) * c.planes * c.stride;
+  c.border = border_.get();
+  // x - d_min - k is inside the right image for every k.
+  c.safe_begin = std::max(0, g.min_disparity + g.disparities - 1);
+  c.safe_end = std::min(width_, width_ + g.min_disparity);
+  return c;
+}
+
+void SgmMatcher::FourPathVertical(FourPathLane& l, int y, uint8_t* out) {
+  const SgmCostRow c = FourPathCostRow(y);
+  uint8_t* out_min = l.mins[l.cur_min].get();
+  four_path_->vertical(c, geometry_, image_row(y),
+                       l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
+                       static_cast<uint8_t>(options_.p1), l.prev, l.prev_min, out, out_min,
+                       nullptr);
+  l.prev = out;
+  l.prev_min = out_min;
+  l.prev_y = y;
+  l.cur_min ^= 1;
+}
+
+void SgmMatcher::FourPathFinish(FourPathLane& l, int y, uint8_t* out) {
+  const SgmCostRow c = FourPathCostRow(y);
+  uint8_t* out_min = l.mins[l.cur_min].get();
+  four_path_->finish_row(c, geometry_, image_row(y),
+                         l.prev != nullptr ? image_row(l.prev_y) : nullptr, p2_table_,
+                         static_cast<uint8_t>(options_.p1), l.prev, l.prev_min, out, out_min,
+                         VolumeRow(y), static_cast<int>(options_.uniqueness_percent),
+                         options_.subpixel, narrow_sums_, l.partial.get(), l.cost.get(),
+                         uniqueness_threshold_.data(), l.scratch.get(),
+                         l.best.get(), l.offset.get(), l.right_best.get());
+  l.prev = out;
+  l.prev_min = out_min;
+  l.prev_y = y;
+  l.cur_min ^= 1;
+}
+
+void SgmMatcher::MatchFourPath() {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const int h = height_, half = h / 2;
+  for (FourPathLane& l : lanes_) {
+    l.prev = nullptr;
+    l.prev_min = nullptr;
+    l.prev_y = -1;
+  }
+  // Each sweep's own half: only its vertical path, straight into the volume.
+  pool_.ForEach(2, [&](int t) {
+    FourPathLane& l = lanes_[t];
+    if (t == 0) {
+      for (int y = 0; y < half; ++y) FourPathVertical(l, y, VolumeRow(y));
+    } else {
+      for (int y = h - 1; y >= half; --y) FourPathVertical(l, y, VolumeRow(y));
+    }
+  });
+  times_.first_half_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  const auto t1 = Clock::now();
+  // The other half, where the volume holds the opposite vertical path: every row finishes.
+  double split[2] = {0, 0};
+  pool_.ForEach(2, [&](int t) {
+    FourPathLane& l = lanes_[t];
+    auto mark = Clock::now();
+    const auto lap = [&](int i) {
+      if (t != 0) return;
+      const auto now = Clock::now();
+      split[i] += std::chrono::duration<double, std::milli>(now - mark).count();
+      mark = now;
+    };
+    const auto finish = [&](int y) {
+      uint8_t* own = l.state[l.cur_state].get() + 64;
+      l.cur_state ^= 1;
+      FourPathFinish(l, y, own);
+      lap(0);
+      FinishPixels(l.best.get(), l.offset.get(), l.right_best.get(), y);
+      lap(1);
+    };
+    if (t == 0) {
+      for (int y = half; y < h; ++y) finish(y);
+    } else {
+      for (int y = half - 1; y >= 0; --y) finish(y);
+    }
+  });
+  times_.second_half_ms = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+  times_.row_pass_ms = split[0];
+  times_.lr_check_ms = split[1];
 }
 
 void SgmMatcher::PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, int y1) const {
@@ -195,25 +338,48 @@ void SgmMatcher::RasterRow(Sweep& s, int y) {
 }
 
 void SgmMatcher::FinishRow(Sweep& s, int y) {
-  const SgmRowGeometry& g = geometry_;
-  const int d_count = g.disparities;
-  kernels_->wta(s.row_sum.get(), g, static_cast<int>(options_.uniqueness_percent),
+  kernels_->wta(s.row_sum.get(), geometry_, static_cast<int>(options_.uniqueness_percent),
                 s.wta_scratch.get(), s.best.get(), s.right_best.get());
+  FinishPixels(s.row_sum.get(), s.best.get(), s.right_best.get(), y);
+}
+
+void SgmMatcher::FinishPixels(const int16_t* best, const int16_t* offset,
+                              const int16_t* right_best, int y) {
+  const SgmRowGeometry& g = geometry_;
   int16_t* out = raw_.get() + static_cast<size_t>(y) * width_;
   const int max_diff = static_cast<int>(options_.lr_max_diff);
   for (int x = 0; x < width_; ++x) {
     out[x] = kInvalidDisparity;
-    const int k = s.best[x];
+    const int k = best[x];
+    if (k < 0) continue;  // not unique
+    const int d = g.min_disparity + k;
+    const int xr = x - d;
+    if (xr < 0 || xr >= width_) continue;  // matched outside the right image
+    if (options_.lr_check && !SgmLeftRightConsistent(k, right_best[xr], max_diff)) continue;
+    out[x] = static_cast<int16_t>(d * kDisparityScale + offset[x]);
+  }
+}
+
+template <class SumT>
+void SgmMatcher::FinishPixels(const SumT* sum, const int16_t* best, const int16_t* right_best,
+                              int y) {
+  const SgmRowGeometry& g = geometry_;
+  const int d_count = g.disparities;
+  int16_t* out = raw_.get() + static_cast<size_t>(y) * width_;
+  const int max_diff = static_cast<int>(options_.lr_max_diff);
+  for (int x = 0; x < width_; ++x) {
+    out[x] = kInvalidDisparity;
+    const int k = best[x];
     if (k < 0) continue;  // not unique
     const int d = g.min_disparity + k;
     const int xr = x - d;
     if (xr < 0 || xr >= width_) continue;  // matched outside the right image
     if (options_.lr_check) {
-      if (!SgmLeftRightConsistent(k, s.right_best[xr], max_diff)) continue;
+      if (!SgmLeftRightConsistent(k, right_best[xr], max_diff)) continue;
     }
     int value = d * kDisparityScale;
     if (options_.subpixel && k > 0 && k < d_count - 1) {
-      const uint16_t* sr = s.row_sum.get() + static_cast<size_t>(x) * d_count;
+      const SumT* sr = sum + static_cast<size_t>(x) * d_count;
       value += SgmSubpixelOffset(sr[k - 1], sr[k], sr[k + 1]);
     }
     out[x] = static_cast<int16_t>(value);
@@ -264,6 +430,19 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
     band(t, h, &y0, &y1);
     for (int y = y0; y < y1; ++y) {
       const ptrdiff_t off = (y + ry_) * pad_stride_ + rx_;
+      if (four_path_ != nullptr) {  // the census as the four-path kernels read it
+        const int cw = static_cast<int>(options_.census_width);
+        const int ch = static_cast<int>(options_.census_height);
+        const int planes = nibble_planes(), stride = nibble_stride();
+        four_path_->census(pad_left_.get() + off, pad_stride_, w, cw, ch,
+                           left_nibbles_.get() + static_cast<size_t>(y) * planes * w, w, false, 0,
+                           w);
+        four_path_->census(pad_right_.get() + off, pad_stride_, w, cw, ch,
+                           nibbles_.get() + static_cast<size_t>(y) * planes * stride, stride, true,
+                           geometry_.rev_base - (w - 1) - geometry_.min_disparity,
+                           geometry_.rev_base + geometry_.disparities);
+        continue;
+      }
       kernels_->census(pad_left_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
                        static_cast<int>(options_.census_height), census_left_.get() + static_cast<size_t>(y) * w);
       kernels_->census(pad_right_.get() + off, pad_stride_, w, static_cast<int>(options_.census_width),
@@ -273,7 +452,10 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
 
   lap(&times_.census_ms);
   for (Sweep& s : sweeps_) s.has_prev = false;
-  if (options_.raster_paths) {
+  if (four_path_ != nullptr) {
+    MatchFourPath();  // times both halves
+    mark = Clock::now();
+  } else if (options_.raster_paths) {
     // FPGA mode: one top-down pass finishes every row as soon as it is reached (no sum volume).
     for (int y = 0; y < h; ++y) RasterRow(sweeps_[0], y);
     lap(&times_.first_half_ms);
@@ -311,7 +493,7 @@ Status SgmMatcher::Match(const StereoMatcherInput& input, StereoMatcherOutput* o
   }
   lap(&times_.median_ms);
   filter_.RemoveSpeckles(disp, w, h, static_cast<int>(options_.speckle_max_size),
-                         static_cast<int>(options_.speckle_max_diff));
+                         static_cast<int>(options_.speckle_max_diff), &pool_);
   if (options_.fill_holes) {
     for (int y = 0; y < h; ++y) DisparityFilter::FillHolesRow(disp + static_cast<size_t>(y) * w, w);
   }

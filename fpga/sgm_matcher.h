@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <memory>
 #include <string_view>
+#include <vector>
 
 #include <hwy/aligned_allocator.h>
 
@@ -40,6 +41,10 @@ class SgmMatcher final : public StereoMatcher {
   struct StageTimes {
     double census_ms = 0, first_half_ms = 0, second_half_ms = 0, median_ms = 0, speckle_ms = 0,
            depth_ms = 0;
+    // The SIMD four-path schedule's second half on the first thread: the fused row pass (cost,
+    // own vertical and both horizontal paths, sum, winner-take-all, uniqueness, sub-pixel), then
+    // the left-right check.
+    double row_pass_ms = 0, lr_check_ms = 0;
   };
   const StageTimes& last_stage_times() const { return times_; }
 
@@ -59,6 +64,33 @@ class SgmMatcher final : public StereoMatcher {
     int prev_y = -1;
   };
 
+  // The SIMD backend's schedule for paths == 4 (SgmFourPathKernels): a top-down and a bottom-up
+  // sweep, each on its own thread, first run over their own half of the image computing only
+  // their vertical path, which they leave in an 8-bit volume (W x H x D uint8, the only full-size
+  // buffer). Then each continues into the other half, where the volume holds the opposite
+  // vertical path, and finishes every row there: its own vertical path, both horizontal paths,
+  // the sum (uint8 when four path costs cannot exceed 255), winner-take-all.
+  struct FourPathLane {
+    Buffer<uint8_t> state[2], mins[2], partial, cost, scratch;
+    Buffer<int16_t> best, offset, right_best;
+    const uint8_t* prev = nullptr;  // the path row of the previous row of the sweep
+    const uint8_t* prev_min = nullptr;
+    int prev_y = -1;
+    int cur_min = 0, cur_state = 0;
+  };
+  void AllocateFourPath();
+  void MatchFourPath();
+  // The cost inputs of row y (SgmCostRow).
+  SgmCostRow FourPathCostRow(int y) const;
+  int nibble_planes() const { return (options_.census_bits() + 3) / 4; }
+  int nibble_stride() const { return geometry_.rev_base + geometry_.disparities + 64; }
+  // Continues the lane's sweep with row y: only the vertical path (first half), or the whole row.
+  void FourPathVertical(FourPathLane& l, int y, uint8_t* out);
+  void FourPathFinish(FourPathLane& l, int y, uint8_t* out);
+  uint8_t* VolumeRow(int y) const {
+    return volume_.get() + 64 + static_cast<size_t>(y) * width_ * geometry_.disparities;
+  }
+
   explicit SgmMatcher(const SgmOptions& options);
   void Allocate(int width, int height);
   void PadImage(const uint8_t* src, int stride, uint8_t* dst, int y0, int y1) const;
@@ -73,6 +105,11 @@ class SgmMatcher final : public StereoMatcher {
   // disparities.
   void RasterRow(Sweep& s, int y);
   void FinishRow(Sweep& s, int y);
+  // Left-right check and sub-pixel offsets of row y from its winners and sums.
+  template <class SumT>
+  void FinishPixels(const SumT* sum, const int16_t* best, const int16_t* right_best, int y);
+  // The same from sub-pixel offsets computed already (0 where none applies).
+  void FinishPixels(const int16_t* best, const int16_t* offset, const int16_t* right_best, int y);
   const uint8_t* image_row(int y) const { return pad_left_.get() + (y + ry_) * pad_stride_ + rx_; }
 
   SgmOptions options_;
@@ -89,6 +126,13 @@ class SgmMatcher final : public StereoMatcher {
   Buffer<uint16_t> sum_;
   Buffer<int16_t> raw_, filtered_;
   Sweep sweeps_[2];
+  const SgmFourPathKernels* four_path_ = nullptr;  // set: MatchFourPath is used
+  bool narrow_sums_ = false;
+  std::vector<uint32_t> uniqueness_threshold_;  // SgmFourPathKernels::finish_row's threshold
+  Buffer<uint8_t> volume_;
+  // SgmCostRow's census nibble planes of every row (left, reversed right) and border costs.
+  Buffer<uint8_t> left_nibbles_, nibbles_, border_;
+  FourPathLane lanes_[2];
   DisparityFilter filter_;
   size_t buffer_bytes_ = 0;
   StageTimes times_;

@@ -14,6 +14,7 @@
 
 #include "fpga/disparity_evaluator.h"
 #include "fpga/opencv_sgbm_matcher.h"
+#include "fpga/stereo_depth.h"
 #include "fpga/stereo_image_io.h"
 #include "mapping/stereo_error_model.h"
 
@@ -98,12 +99,19 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
   struct Case {
     int w, h, min_d, num_d, paths, cw, ch, threads;
     bool raster = false;
+    int p2 = 40;  // 4 * (census bits + p2) <= 255 gives the SIMD four-path schedule uint8 sums
   };
   const Case cases[] = {{97, 41, 0, 32, 4, 9, 7, 2},        {97, 41, 0, 32, 8, 9, 7, 1},
                         {64, 30, -8, 48, 4, 5, 5, 2},       {130, 23, 3, 64, 8, 7, 5, 3},
                         {33, 17, 0, 128, 4, 9, 7, 2},       {80, 40, 0, 16, 8, 3, 3, 2},
                         {97, 41, 0, 32, 4, 5, 5, 2, true},  {64, 30, -8, 48, 4, 9, 7, 1, true},
-                        {33, 17, 0, 128, 4, 5, 5, 2, true}};
+                        {33, 17, 0, 128, 4, 5, 5, 2, true},
+                        // The SIMD four-path schedule: uint8 sums up to D = 256, uint16 sums,
+                        // 16-byte vectors (D = 48), one or two rows, a negative d_min.
+                        {70, 9, 0, 256, 4, 5, 5, 2},        {45, 1, 0, 32, 4, 5, 5, 2},
+                        {50, 2, -16, 64, 4, 9, 7, 2},       {31, 12, 5, 48, 4, 3, 3, 1},
+                        {90, 25, 0, 64, 4, 5, 5, 2, false, 60},
+                        {61, 14, -4, 48, 4, 7, 7, 2, false, 70}};
   uint32_t seed = 1;
   for (const Case& c : cases) {
     // Random left image; the right one is the left shifted by 5 px plus strong noise, so that
@@ -127,6 +135,9 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
     o.census_width = c.cw;
     o.census_height = c.ch;
     o.threads = c.threads;
+    o.p2 = c.p2;
+    o.uniqueness_percent = seed % 3 == 0 ? 0 : (seed % 3 == 1 ? 5 : 12);
+    if (c.h < 4) o.speckle_max_size = 0;  // every region of one or two rows is a speckle
     o.backend = SgmBackend::kScalar;
     const auto a = RunSgm(o, l, r, c.w, c.h);
     o.backend = SgmBackend::kSimd;
@@ -136,7 +147,7 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
                                         << " paths " << c.paths << " raster " << c.raster;
     const long valid = std::count_if(a.disparity.begin(), a.disparity.end(),
                                       [](int16_t d) { return d != kInvalidDisparity; });
-    EXPECT_GT(valid, 0);
+    EXPECT_GT(valid, 0) << c.w << "x" << c.h << " d " << c.min_d << "+" << c.num_d;
   }
 }
 
@@ -191,7 +202,8 @@ TEST(SgmMatcherTest, MemoryAtFullResolutionStaysUnder200MB) {
   StereoMatcherOutput out;
   ASSERT_TRUE((*m)->Match(InputOf(img.data(), img.data(), w, h, w), &out).ok());
   EXPECT_LT((*m)->buffer_bytes(), 200u * 1000 * 1000);
-  EXPECT_GT((*m)->buffer_bytes(), static_cast<size_t>(w) * h * 128 * 2);  // holds the sum volume
+  // Holds the volume of one vertical path (uint8; the scalar schedule's sum volume is uint16).
+  EXPECT_GT((*m)->buffer_bytes(), static_cast<size_t>(w) * h * 128);
 }
 
 TEST(SgmMatcherTest, RecoversConstantDisparity) {
@@ -347,6 +359,35 @@ TEST(SgmMatcherTest, DepthAndSigmaFollowTheErrorModel) {
     ++checked;
   }
   EXPECT_GT(checked, w * h / 2);
+}
+
+// The tabulated depth is the direct formula's float, bit for bit.
+TEST(SgmMatcherTest, DepthTableGivesTheDirectFloats) {
+  std::mt19937 rng(9);
+  StereoMatcherOutput out;
+  ResizeStereoOutput(301, 40, &out);
+  for (auto& d : out.disparity) {
+    d = rng() % 9 == 0 ? kInvalidDisparity : static_cast<int16_t>(static_cast<int>(rng() % 2300) - 40);
+  }
+  StereoMatcherInput in;
+  in.width = 301;
+  in.height = 40;
+  in.focal_px = 512.3;
+  in.baseline_m = 0.11;
+  in.disparity_offset_px = 0.7;
+  ComputeStereoDepth(in, 0.5, &out, 0, 40);
+  const StereoErrorModel model(in.focal_px, in.baseline_m, 0.5);
+  for (size_t i = 0; i < out.disparity.size(); ++i) {
+    const int16_t d = out.disparity[i];
+    const double disp = static_cast<double>(d) / kDisparityScale + in.disparity_offset_px;
+    if (d == kInvalidDisparity || disp <= 0.0) {
+      ASSERT_TRUE(std::isnan(out.depth[i]) && std::isnan(out.depth_sigma[i])) << i;
+      continue;
+    }
+    const double z = in.focal_px * in.baseline_m / disp;
+    ASSERT_EQ(out.depth[i], static_cast<float>(z)) << i;
+    ASSERT_EQ(out.depth_sigma[i], static_cast<float>(model.DepthError(z))) << i;
+  }
 }
 
 TEST(SgmMatcherTest, RejectsBadInputAndOptions) {

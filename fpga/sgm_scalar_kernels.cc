@@ -61,13 +61,6 @@ uint8_t SgmPathStep(const uint8_t* c, const uint8_t* prev, uint8_t min_prev, uin
   return best;
 }
 
-int SgmSubpixelOffset(int below, int at, int above) {
-  const int den = std::max(below, above) - at;
-  if (den <= 0) return 0;
-  const int num = (below - above) * (kDisparityScale / 2);
-  return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
-}
-
 namespace {
 
 constexpr auto Step = SgmPathStep;

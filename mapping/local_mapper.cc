@@ -71,6 +71,8 @@ std::shared_ptr<const Submap> LocalMapper::OnFrameSwitch(uint64_t new_frame_id, 
   return done;
 }
 
+std::shared_ptr<const Submap> LocalMapper::FinishOpenSubmap() { return FinishAndStart(open_->metadata().id); }
+
 std::shared_ptr<const Submap> LocalMapper::TakeFinished() { return std::exchange(finished_, nullptr); }
 
 }  // namespace cairn

@@ -45,6 +45,9 @@ class LocalMapper {
   // The filter switched from the open submap's frame to `new_frame_id` (T_old_new from its
   // FrameSwitchResult). Returns the finished submap (nullptr if it saw no image).
   std::shared_ptr<const Submap> OnFrameSwitch(uint64_t new_frame_id, const Eigen::Isometry3d& T_old_new);
+  // End of a run: the open submap finished as it is (nullptr if it saw no image); an empty one
+  // in the same frame takes its place.
+  std::shared_ptr<const Submap> FinishOpenSubmap();
 
   const RollingObstacleMap& obstacle_map() const { return rolling_; }
   const OpenSubmap& open_submap() const { return *open_; }

@@ -96,52 +96,114 @@ void MapComposer::Contribute(const octomap::OcTree& tree, const std::vector<Clou
   const Eigen::Vector3f offsets[8] = {
       {-0.25f, -0.25f, 0.0f},   {0.25f, -0.25f, 0.0f},   {-0.25f, 0.25f, 0.0f},   {0.25f, 0.25f, 0.0f},
       {-0.25f, -0.25f, -0.25f}, {0.25f, -0.25f, -0.25f}, {-0.25f, 0.25f, -0.25f}, {0.25f, 0.25f, -0.25f}};
-  resample_.Clear();
+  // Leaves first, for the bounding box of the moved tree.
   const int tree_depth = static_cast<int>(tree.getTreeDepth());
+  leaves_.clear();
+  Eigen::Vector3i lo = Eigen::Vector3i::Constant(std::numeric_limits<int>::max()), hi = -lo;
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    const float value = it->getLogOdds();
+    const octomap::OcTreeKey k = it.getIndexKey();  // the leaf's lowest finest voxel
     const int cells = 1 << (tree_depth - static_cast<int>(it.getDepth()));
-    // Key of the leaf's lowest finest voxel.
-    const octomap::OcTreeKey k = it.getIndexKey();
+    const Eigen::Vector3i a(k[0] - kTreeMaxKey, k[1] - kTreeMaxKey, k[2] - kTreeMaxKey);
+    leaves_.push_back({a, cells, it->getLogOdds()});
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(a + Eigen::Vector3i::Constant(cells));
+  }
+  // Samples land in a dense grid over the moved box when it is small enough (every submap made
+  // along a few metres is), which costs an index instead of a hash lookup per sample.
+  resample_.Clear();
+  bool dense = false;
+  Eigen::Vector3i g0 = Eigen::Vector3i::Zero(), dims = Eigen::Vector3i::Zero();
+  if (!leaves_.empty()) {
+    Eigen::Vector3f bmin = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), bmax = -bmin;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3f corner((c & 1 ? hi.x() : lo.x()) * static_cast<float>(res),
+                                   (c & 2 ? hi.y() : lo.y()) * static_cast<float>(res),
+                                   (c & 4 ? hi.z() : lo.z()) * static_cast<float>(res));
+      const Eigen::Vector3f g = R * corner + t;
+      bmin = bmin.cwiseMin(g);
+      bmax = bmax.cwiseMax(g);
+    }
+    const Eigen::Vector3f fmin = (bmin * inv).array().floor() - 2.0f, fmax = (bmax * inv).array().floor() + 2.0f;
+    const Eigen::Vector3f extent = fmax - fmin + Eigen::Vector3f::Ones();
+    constexpr double kMaxDenseCells = 1 << 23;
+    if ((fmin.array() > -1e6f).all() && (fmax.array() < 1e6f).all() &&
+        static_cast<double>(extent.x()) * extent.y() * extent.z() <= kMaxDenseCells) {
+      dense = true;
+      g0 = fmin.cast<int>();
+      dims = extent.cast<int>();
+      const size_t cells = static_cast<size_t>(dims.x()) * static_cast<size_t>(dims.y()) * static_cast<size_t>(dims.z());
+      if (dense_.size() < cells) dense_.resize(cells);
+      touched_.clear();
+    }
+  }
+  const auto add = [&](const Eigen::Vector3f& g, float value) {
+    if (dense) {
+      const Eigen::Vector3f f = (g * inv).array().floor();
+      const int x = static_cast<int>(f.x()) - g0.x(), y = static_cast<int>(f.y()) - g0.y(), z = static_cast<int>(f.z()) - g0.z();
+      if (x >= 0 && y >= 0 && z >= 0 && x < dims.x() && y < dims.y() && z < dims.z()) {
+        const uint32_t i = static_cast<uint32_t>((z * dims.y() + y) * dims.x() + x);
+        Occ& o = dense_[i];
+        if (o.n == 0) touched_.push_back(i);
+        o.sum += value;
+        ++o.n;
+        return;
+      }
+    }
+    uint64_t key;
+    if (!VoxelKey::Of(g, inv, &key)) return;
+    Occ& o = resample_[key];
+    o.sum += value;
+    ++o.n;
+  };
+  const float fres = static_cast<float>(res);
+  for (const Leaf& leaf : leaves_) {
+    const float value = leaf.value;
+    const int cells = leaf.cells;
     for (int dz = 0; dz < cells; ++dz) {
       for (int dy = 0; dy < cells; ++dy) {
         for (int dx = 0; dx < cells; ++dx) {
-          const Eigen::Vector3f c((static_cast<int>(k[0]) + dx - kTreeMaxKey + 0.5f) * static_cast<float>(res),
-                                  (static_cast<int>(k[1]) + dy - kTreeMaxKey + 0.5f) * static_cast<float>(res),
-                                  (static_cast<int>(k[2]) + dz - kTreeMaxKey + 0.5f) * static_cast<float>(res));
+          const Eigen::Vector3f c((leaf.min.x() + dx + 0.5f) * fres, (leaf.min.y() + dy + 0.5f) * fres,
+                                  (leaf.min.z() + dz + 0.5f) * fres);
           const Eigen::Vector3f g = R * c + t;
-          uint64_t key;
           if (aligned) {
-            if (VoxelKey::Of(g, inv, &key)) {
-              Occ& o = resample_[key];
-              o.sum += value;
-              ++o.n;
-            }
+            add(g, value);
             continue;
           }
           for (int si = 0; si < samples; ++si) {
             // The 8-sample set: the z = -1/4 layer above plus the same x-y pattern at z = +1/4.
             Eigen::Vector3f off = offsets[si];
             if (samples == 8 && si < 4) off.z() = 0.25f;
-            if (!VoxelKey::Of(g + R * (off * static_cast<float>(res)), inv, &key)) continue;
-            Occ& o = resample_[key];
-            o.sum += value;
-            ++o.n;
+            add(g + R * (off * fres), value);
           }
         }
       }
     }
   }
   occupancy->clear();
-  occupancy->reserve(resample_.size());
+  occupancy->reserve(resample_.size() + touched_.size());
   resample_.ForEach([&](uint64_t key, const Occ& o) { occupancy->emplace_back(key, o.sum / static_cast<float>(o.n)); });
+  if (dense) {
+    for (const uint32_t i : touched_) {
+      Occ& o = dense_[i];
+      const int x = static_cast<int>(i % static_cast<uint32_t>(dims.x()));
+      const int y = static_cast<int>(i / static_cast<uint32_t>(dims.x()) % static_cast<uint32_t>(dims.y()));
+      const int z = static_cast<int>(i / (static_cast<uint32_t>(dims.x()) * static_cast<uint32_t>(dims.y())));
+      occupancy->emplace_back(VoxelKey::Pack(g0.x() + x, g0.y() + y, g0.z() + z), o.sum / static_cast<float>(o.n));
+      o = Occ{};
+    }
+    touched_.clear();
+  }
 }
 
 void MapComposer::Apply(const Entry& e, int sign) {
-  for (const CloudPoint& p : e.cloud) cloud_.Add(p, sign);
+  cloud_.AddAll(e.cloud, sign);
   const float s = static_cast<float>(sign);
-  for (const auto& [key, value] : e.occupancy) {
+  constexpr size_t kAhead = 16;
+  for (size_t i = 0; i < e.occupancy.size(); ++i) {
+    if (i + kAhead < e.occupancy.size()) occupancy_.Prefetch(e.occupancy[i + kAhead].first);
+    const auto& [key, value] = e.occupancy[i];
     Occ& o = occupancy_[key];
+    known_voxels_ += (o.n == 0) - (o.n + sign == 0);
     o.sum += s * value;
     o.n += sign;
     if (o.n == 0) o.sum = 0.0f;  // no rounding residue on emptied voxels
@@ -170,13 +232,16 @@ CompositionStats MapComposer::Update() {
     for (const CloudPoint& p : open_points_) open_cloud_.Add(p);
     for (const auto& [key, value] : open_pairs_) open_occupancy_[key] = value;
   }
-  occupancy_.ForEach([&](uint64_t, const Occ& o) { stats.voxels += o.n > 0; });
+  // Counted as contributions come and go: a scan of the global table would cost more than an
+  // incremental update itself.
+  stats.voxels = known_voxels_;
   return stats;
 }
 
 CompositionStats MapComposer::Rebuild() {
   cloud_.Clear();
   occupancy_.Clear();
+  known_voxels_ = 0;
   for (auto& [ref, e] : entries_) e.applied = false;
   return Update();
 }

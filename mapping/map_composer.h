@@ -91,13 +91,22 @@ class MapComposer {
   std::map<SubmapRef, Entry> entries_;
   VoxelCloud cloud_;
   VoxelHashMap<Occ> occupancy_;
+  int64_t known_voxels_ = 0;  // entries of occupancy_ with n > 0
   // The open submap's merged contribution, rebuilt on each Update().
   const OpenSubmap* open_ = nullptr;
   Eigen::Isometry3d open_pose_ = Eigen::Isometry3d::Identity();
   VoxelCloud open_cloud_;
   VoxelHashMap<float> open_occupancy_;
   // Scratch.
-  VoxelHashMap<Occ> resample_;
+  struct Leaf {
+    Eigen::Vector3i min;  // lowest finest voxel, signed grid index
+    int cells;            // finest voxels per side
+    float value;
+  };
+  std::vector<Leaf> leaves_;
+  std::vector<Occ> dense_;         // resampling grid over a moved submap's box, all zero between uses
+  std::vector<uint32_t> touched_;  // its cells in use
+  VoxelHashMap<Occ> resample_;     // samples outside the dense grid
   std::vector<CloudPoint> open_points_;
   std::vector<std::pair<uint64_t, float>> open_pairs_;
 };

@@ -1,6 +1,5 @@
-// Mapping against the simulator's ground truth: occupied voxels vs. the true surface, and a
-// partitioned submap chain re-composed. (Obstacle precision/recall is measured by
-// `cairn bench map`.)
+// Mapping against the simulator's ground truth: obstacle cells vs. the true terrain's steps,
+// occupied voxels vs. the true surface, and a partitioned submap chain re-composed.
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +10,7 @@
 
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
+#include "mapping/obstacle_ground_truth.h"
 #include "mapping/sim_depth_scenes.h"
 
 namespace cairn {
@@ -170,6 +170,45 @@ TEST(MappingSimTest, OccupiedVoxelsLieOnTheTrueSurface) {
   EXPECT_GE(static_cast<double>(near), 0.95 * static_cast<double>(occupied));
   // The cloud points carry the classifier's obstacle flags.
   EXPECT_GT(submap->points().size(), 10000u);
+}
+
+// Every fourth image of the drive of `cairn bench map` (default world, 7 m, 0.2 px disparity
+// noise): obstacle cells against the true terrain (mapping/obstacle_ground_truth.h).
+TEST(MappingSimTest, ObstacleCellsMatchTheTrueTerrain) {
+  const sim::Terrain terrain = sim::Terrain::Generate(sim::WorldOptions{});
+  const StereoCamera cam = testing::RoverCamera(1.0);
+  MappingOptions o;
+  DepthProjector projector(o.depth, cam);
+  ObstacleClassifier classifier(o.obstacles, cam, projector.error_model(), projector.range());
+  CameraPoints pts;
+  ObstacleResult result;
+  testing::ObstacleScore score, fixed_band;
+  const int images = 44;
+  for (int i = 0; i < images; i += 4) {
+    const double s = 7.0 * i / (images - 1);
+    const double x = -8.0 + s, y = 3.0 + std::sin(0.3 * s), yaw = std::atan(0.3 * std::cos(0.3 * s));
+    const Eigen::Isometry3d T = ForwardCameraPose({x, y, terrain.Height(x, y) + 1.3}, yaw, kTilt);
+    const DepthImage img = testing::RenderSimulatedDepth(terrain, cam, T, static_cast<unsigned>(i + 1), 0.2);
+    ASSERT_TRUE(projector.Project(img, T, &pts).ok());
+    ASSERT_TRUE(classifier.Classify(img, &pts, &result).ok());
+    score.Add(testing::ScoreObstacles(terrain, result, o.obstacles, T, projector.error_model()));
+    fixed_band.Add(testing::ScoreObstacles(terrain, result, o.obstacles, T, projector.error_model(), 0.03, false));
+  }
+  std::printf("obstacle cells vs ground truth: precision %.3f recall %.3f (tp %lld fp %lld fn %lld, %lld unscored: within "
+              "the stereo error of h_max, or undetectable edges; %lld misses are hidden drops only); with a fixed 0.03 m band "
+              "instead: precision %.3f recall %.3f (tp %lld fp %lld fn %lld)\n",
+              score.precision(), score.recall(), static_cast<long long>(score.tp), static_cast<long long>(score.fp),
+              static_cast<long long>(score.fn), static_cast<long long>(score.unscored),
+              static_cast<long long>(score.fn_edge_only), fixed_band.precision(), fixed_band.recall(),
+              static_cast<long long>(fixed_band.tp), static_cast<long long>(fixed_band.fp),
+              static_cast<long long>(fixed_band.fn));
+  EXPECT_GT(score.tp, 50);
+  EXPECT_GE(score.precision(), 0.95);
+  EXPECT_GE(fixed_band.precision(), 0.95);
+  // Issue 10 asks for recall >= 0.90; not reached yet (see the issue). These floors keep what is
+  // reached from regressing.
+  EXPECT_GE(score.recall(), 0.70);
+  EXPECT_GE(fixed_band.recall(), 0.40);
 }
 
 }  // namespace

@@ -1,10 +1,71 @@
 #include "mapping/occupancy_integrator.h"
 
+#include <bit>
 #include <cmath>
 
 namespace cairn {
 namespace {
 uint64_t PackOctoKey(const octomap::OcTreeKey& k) { return VoxelKey::Pack(k[0], k[1], k[2]); }
+
+// OcTree::updateNode(key, occupied, lazy) for every key, with the same result (including its
+// early abort on saturated nodes), but without its two descents from the root per key: the keys
+// come in spatially coherent order (along rays, along image rows), so the path of the previous
+// key is reused down to the deepest node both share.
+void UpdateLeaves(octomap::OcTree* tree, const std::vector<octomap::OcTreeKey>& keys, bool occupied) {
+  if (keys.empty()) return;
+  const float update = occupied ? tree->getProbHitLog() : tree->getProbMissLog();
+  const float lo = tree->getClampingThresMinLog(), hi = tree->getClampingThresMaxLog();
+  const auto saturated = [&](const octomap::OcTreeNode* n) {
+    return update >= 0.0f ? n->getLogOdds() >= hi : n->getLogOdds() <= lo;
+  };
+  size_t first = 0;
+  if (tree->getRoot() == nullptr) {
+    // The root can only be made through the tree's own update.
+    tree->updateNode(keys[0], update, true);
+    first = 1;
+  }
+  constexpr int kDepth = 16;
+  // path[d]: the node at depth d on the previous key's path; valid up to `valid`.
+  octomap::OcTreeNode* path[kDepth + 1];
+  path[0] = tree->getRoot();
+  int valid = 0;
+  octomap::OcTreeKey prev;
+  for (size_t i = first; i < keys.size(); ++i) {
+    const octomap::OcTreeKey& key = keys[i];
+    int d = 0;  // deepest depth shared with the previous key's valid path
+    if (valid > 0) {
+      const unsigned diff = static_cast<unsigned>((key[0] ^ prev[0]) | (key[1] ^ prev[1]) | (key[2] ^ prev[2]));
+      d = std::min(valid, kDepth - static_cast<int>(std::bit_width(diff)));
+    }
+    prev = key;
+    octomap::OcTreeNode* node = path[d];
+    bool skip = false;
+    bool created = false;
+    for (; d < kDepth; ++d) {
+      const unsigned pos = octomap::computeChildIdx(key, kDepth - 1 - d);
+      if (!tree->nodeChildExists(node, pos)) {
+        if (!created && !tree->nodeHasChildren(node)) {
+          // A pruned leaf standing for the whole subtree: OctoMap leaves it alone when the update
+          // cannot change it, and expands it otherwise.
+          if (saturated(node)) {
+            skip = true;
+            break;
+          }
+          tree->expandNode(node);
+        } else {
+          tree->createNodeChild(node, pos);
+          created = true;
+        }
+      }
+      node = tree->getNodeChild(node, pos);
+      path[d + 1] = node;
+    }
+    valid = d;
+    if (skip || saturated(node)) continue;
+    tree->updateNodeLogOdds(node, update);
+  }
+}
+
 }  // namespace
 
 std::unique_ptr<octomap::OcTree> MakeOccupancyTree(const SubmapOptions& o) {
@@ -47,9 +108,14 @@ OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, oct
   overflow_.Clear();
   occupied_.clear();
   free_.clear();
-  octomap::OcTreeKey key;
+  octomap::OcTreeKey key, last(0, 0, 0);
+  bool have_last = false;
   for (const Eigen::Vector3f& p : pts.p_local) {
     if (!tree->coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
+    // Neighbouring pixels of a row mostly fall into the same 0.1 m voxel.
+    if (have_last && key == last) continue;
+    last = key;
+    have_last = true;
     uint32_t& s = Stamp(key);
     if (s != kOccupied) {
       s = kOccupied;
@@ -76,8 +142,8 @@ OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, oct
     seen = 1;
     cast(tree->keyToCoord(key));
   }
-  for (const octomap::OcTreeKey& k : free_) tree->updateNode(k, false, true);
-  for (const octomap::OcTreeKey& k : occupied_) tree->updateNode(k, true, true);
+  UpdateLeaves(tree, free_, false);
+  UpdateLeaves(tree, occupied_, true);
   stats.occupied = static_cast<int64_t>(occupied_.size());
   stats.free = static_cast<int64_t>(free_.size());
   return stats;

@@ -17,18 +17,40 @@ size_t VoxelCloud::size() const {
 bool VoxelCloud::Add(const Eigen::Vector3f& p, uint8_t r, uint8_t g, uint8_t b, bool obstacle, int32_t weight) {
   uint64_t key;
   if (!VoxelKey::Of(p, inv_res_, &key)) return false;
+  CloudPoint c;
+  c.p = p;
+  c.r = r;
+  c.g = g;
+  c.b = b;
+  c.obstacle = obstacle;
+  AddKeyed(key, c, weight);
+  return true;
+}
+
+void VoxelCloud::AddKeyed(uint64_t key, const CloudPoint& c, int32_t weight) {
   const Eigen::Vector3f corner = VoxelKey::Unpack(key).cast<float>() * static_cast<float>(res_);
   Accum& a = voxels_[key];
   const float w = static_cast<float>(weight);
-  a.sx += w * (p.x() - corner.x());
-  a.sy += w * (p.y() - corner.y());
-  a.sz += w * (p.z() - corner.z());
+  a.sx += w * (c.p.x() - corner.x());
+  a.sy += w * (c.p.y() - corner.y());
+  a.sz += w * (c.p.z() - corner.z());
   a.n += weight;
-  a.sr += weight * r;
-  a.sg += weight * g;
-  a.sb += weight * b;
-  a.obstacles += obstacle ? weight : 0;
-  return true;
+  a.sr += weight * c.r;
+  a.sg += weight * c.g;
+  a.sb += weight * c.b;
+  a.obstacles += c.obstacle ? weight : 0;
+}
+
+void VoxelCloud::AddAll(const std::vector<CloudPoint>& points, int32_t weight) {
+  keys_.resize(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!VoxelKey::Of(points[i].p, inv_res_, &keys_[i])) keys_[i] = VoxelKey::kEmpty;
+  }
+  constexpr size_t kAhead = 16;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (i + kAhead < points.size() && keys_[i + kAhead] != VoxelKey::kEmpty) voxels_.Prefetch(keys_[i + kAhead]);
+    if (keys_[i] != VoxelKey::kEmpty) AddKeyed(keys_[i], points[i], weight);
+  }
 }
 
 size_t VoxelCloud::AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,

@@ -37,6 +37,10 @@ class VoxelCloud {
   size_t AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
                   const std::vector<uint8_t>& obstacle);
 
+  // Add() of many points at once; scattered points (a moved submap's cloud) are looked up with
+  // prefetching, which hides most of the cache misses of a large table.
+  void AddAll(const std::vector<CloudPoint>& points, int32_t weight);
+
   // Centroids, in key order of the hash table (not sorted).
   std::vector<CloudPoint> Points() const;
   // Centroids of this cloud and `other` together (same resolution), without changing either.
@@ -61,10 +65,12 @@ class VoxelCloud {
     }
   };
   CloudPoint Centroid(uint64_t key, const Accum& a) const;
+  void AddKeyed(uint64_t key, const CloudPoint& c, int32_t weight);
 
   double res_;
   float inv_res_;
   VoxelHashMap<Accum> voxels_;
+  std::vector<uint64_t> keys_;  // scratch of AddAll
 };
 
 }  // namespace cairn

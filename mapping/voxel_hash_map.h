@@ -79,6 +79,9 @@ class VoxelHashMap {
       i = (i + 1) & mask_;
     }
   }
+  // Starts loading the slot `key` hashes to, for loops over many scattered keys in a large table.
+  void Prefetch(uint64_t key) const { __builtin_prefetch(&slots_[Hash(key) & mask_]); }
+
   const V* Find(uint64_t key) const {
     size_t i = Hash(key) & mask_;
     while (true) {

@@ -26,7 +26,9 @@ if ((status != 0)); then
 fi
 data="${CAIRN_DATA_DIR:-../shared/data}/euroc-v1_01-micro"
 if [[ -d "$data" ]]; then
-  "$cairnd" --config configs/euroc.yaml --replay "$data" --out out/euroc --log-level warn
+  # Dense stereo and mapping on the real pairs too (off in the EuRoC profile, which tests replay).
+  "$cairnd" --config configs/euroc.yaml --replay "$data" --out out/euroc --log-level warn \
+    --set stereo.enabled=true --set mapping.enabled=true
 else
   echo "demo: skipping the EuRoC replay: missing $data (the shared data sets next to this checkout)"
 fi

@@ -83,7 +83,9 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   EXPECT_EQ(r["serverInfo"].string(), "cairnd euroc-mav");
   EXPECT_TRUE(r["errors"].array().empty()) << client.output;
   // The shipped configuration streams images as JPEG (foxglove.CompressedImage).
-  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image/compressed", "/cam1/image/compressed", "/diagnostics"}) {
+  // Sensor channels, and the filter's poses and transforms (foxglove.PoseInFrame, FrameTransform).
+  for (const char* topic : {"/imu", "/stereo/info", "/cam0/image/compressed", "/cam1/image/compressed", "/diagnostics",
+                            "/pose", "/tf"}) {
     const testing::JsonValue& c = r["channels"][topic];
     EXPECT_GT(c["count"].number(), 0) << topic;
     EXPECT_EQ(c["decodeErrors"].number(), 0) << topic;
@@ -99,6 +101,10 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   EXPECT_LT(image["bytes"].number(), 752 * 480 / 3);
   EXPECT_EQ(r["channels"]["/cam0/image"]["count"].number(), 0);  // advertised, not sent
   EXPECT_EQ(r["channels"]["/wheel_odometry"]["schema"].string(), "cairn.msg.WheelOdometrySample");
+  EXPECT_EQ(r["channels"]["/pose"]["schema"].string(), "foxglove.PoseInFrame");
+  EXPECT_EQ(r["channels"]["/tf"]["schema"].string(), "foxglove.FrameTransform");
+  EXPECT_EQ(r["channels"]["/map/submaps"]["schema"].string(), "foxglove.PointCloud");
+  EXPECT_EQ(r["channels"]["/map/obstacles"]["schema"].string(), "foxglove.Grid");
   const testing::JsonValue d = testing::JsonValue::ParseFile(out + "/diagnostics.json");
   EXPECT_EQ(d["live_stream"]["port"].number(), port);
   EXPECT_GT(d["live_stream"]["published"].number(), 400);

@@ -1,6 +1,8 @@
-// cairn bench filter [--samples N] [--delay S] [--switch-period S]: wall time per IMU
-// propagation, delayed relative-pose update, wheel update and frame switch of the local reference
-// filter on a simulated run (200 Hz IMU, 20 Hz clones and relative poses, 20 Hz wheel odometry).
+// cairn bench filter [--samples N] [--delay S] [--switch-period S] [--wheel-rate HZ]
+// [--nonholonomic]: wall time per IMU propagation, delayed relative-pose update, wheel update and
+// frame switch of the local reference filter on a simulated run (200 Hz IMU, 20 Hz clones and
+// relative poses, 20 Hz wheel odometry by default; the rover profile's CAN odometry runs at
+// 100 Hz with the non-holonomic constraint: --wheel-rate 100 --nonholonomic).
 
 #include <algorithm>
 #include <cstdio>
@@ -37,7 +39,8 @@ void PrintStats(const Timings& t, bool last) {
 
 int RunBenchFilter(const CommandArgs& args) {
   long samples = 120000;
-  double delay = 0.25, switch_period = 10.0;
+  double delay = 0.25, switch_period = 10.0, wheel_rate = 20.0;
+  bool nonholonomic = false;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has_value = i + 1 < args.args.size();
@@ -47,22 +50,31 @@ int RunBenchFilter(const CommandArgs& args) {
       delay = std::strtod(args.args[++i], nullptr);
     } else if (a == "--switch-period" && has_value) {
       switch_period = std::strtod(args.args[++i], nullptr);
+    } else if (a == "--wheel-rate" && has_value) {
+      wheel_rate = std::strtod(args.args[++i], nullptr);
+    } else if (a == "--nonholonomic") {
+      nonholonomic = true;
     } else {
-      std::fprintf(stderr, "usage: cairn bench filter [--samples N] [--delay S] [--switch-period S]\n");
+      std::fprintf(stderr,
+                   "usage: cairn bench filter [--samples N] [--delay S] [--switch-period S] [--wheel-rate HZ] "
+                   "[--nonholonomic]\n");
       return 2;
     }
   }
-  if (samples < 1000 || delay < 0.0 || delay > 0.45 || switch_period <= 0.0) {
-    std::fprintf(stderr, "cairn bench filter: need --samples >= 1000, 0 <= --delay <= 0.45, --switch-period > 0\n");
+  if (samples < 1000 || delay < 0.0 || delay > 0.45 || switch_period <= 0.0 || wheel_rate < 0.0 || wheel_rate > 200.0) {
+    std::fprintf(stderr,
+                 "cairn bench filter: need --samples >= 1000, 0 <= --delay <= 0.45, --switch-period > 0, "
+                 "0 <= --wheel-rate <= 200\n");
     return 2;
   }
   testing::ScenarioOptions s;
   s.duration = static_cast<double>(samples) / 200.0;
   s.update_delay = delay;
-  s.wheel_rate = 20.0;
+  s.wheel_rate = wheel_rate;
   s.switch_period = switch_period;
   FilterOptions o;
   o.wheel_enabled = true;
+  o.nonholonomic = nonholonomic;
   testing::FilterScenario scenario(s, o);
   std::vector<Timings> t = {{"imu_propagation", {}}, {"relative_pose_update", {}},
                             {"wheel_update", {}}, {"frame_switch", {}}};
@@ -71,8 +83,8 @@ int RunBenchFilter(const CommandArgs& args) {
   }
   const FilterCounters& c = scenario.filter().counters();
   std::printf("{\n  \"benchmark\": \"filter\",\n  \"imu_rate_hz\": 200, \"update_rate_hz\": 20, "
-              "\"update_delay_s\": %.3f, \"max_clones\": %d,\n",
-              delay, kMaxClones);
+              "\"update_delay_s\": %.3f, \"max_clones\": %d, \"wheel_rate_hz\": %.1f, \"nonholonomic\": %s,\n",
+              delay, kMaxClones, wheel_rate, nonholonomic ? "true" : "false");
   std::printf("  \"imu_samples\": %zu, \"updates_applied\": %lu, \"updates_rejected\": %lu, "
               "\"replays\": %lu, \"replayed_imu_samples\": %lu,\n",
               t[0].us.size(), static_cast<unsigned long>(c.updates_applied),

@@ -389,6 +389,13 @@ int RunBenchStereo(const CommandArgs& args) {
               stage_median(&SgmMatcher::StageTimes::median_ms),
               stage_median(&SgmMatcher::StageTimes::speckle_ms),
               stage_median(&SgmMatcher::StageTimes::depth_ms), ours_sgm->buffer_bytes() / 1e6);
+  if (stage_median(&SgmMatcher::StageTimes::row_pass_ms) > 0.0) {
+    std::printf("  %s second half on thread 0 (median ms): fused row pass (cost, own vertical and "
+                "both horizontal paths, sum, WTA, uniqueness, sub-pixel) %.2f, LR check %.2f\n",
+                std::string(matchers[0]->name()).c_str(),
+                stage_median(&SgmMatcher::StageTimes::row_pass_ms),
+                stage_median(&SgmMatcher::StageTimes::lr_check_ms));
+  }
   return 0;
 }
 

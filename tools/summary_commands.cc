@@ -72,6 +72,16 @@ int RunSummary(const CommandArgs& args) {
                     e["camera_frames"].number(), e["trajectory_poses"].number(), e["vo"]["failures"].number(),
                     e["frame_switches"]["count"].number());
       }
+      if (s.has("mapping")) {
+        const JsonValue& m = s["mapping"];
+        const JsonValue& d = m["dense_stereo"];
+        std::printf("  mapping: %.0f pairs matched on %s (FPGA %.0f, CPU %.0f, FPGA failures %.0f), %.0f images "
+                    "mapped, %.0f submaps (%.0f KB), map of %.0f points\n",
+                    d["pairs"].number(), d["backend"].string().c_str(), d["fpga_frames"].number(),
+                    d["cpu_frames"].number(), d["fpga_failures"].number(), m["images_mapped"].number(),
+                    m["submaps"]["finished"].number(), m["submaps"]["bytes"].number() / 1024.0,
+                    m["map_points"].number());
+      }
       PrintAccuracy(dir);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());

@@ -114,6 +114,7 @@ TEST(MissionSimulatorTest, RobotsSeeEachOther) {
 TEST(MissionSimulatorTest, MotionBlurSmoothsTheImage) {
   MissionOptions m = ShortMission();
   m.robots = {"hexacopter"};
+  m.duration = 3.5;  // it hovers for the first 2 s
   m.image_scale = 0.2;
   m.render.read_noise = 0.0;
   m.render.shot_noise = 0.0;
@@ -123,8 +124,8 @@ TEST(MissionSimulatorTest, MotionBlurSmoothsTheImage) {
   auto blurred = MissionSimulator::Create(SmallWorld(3), m);
   ASSERT_TRUE(sharp.ok() && blurred.ok());
   std::vector<uint8_t> a, b, unused;
-  (*sharp)->RenderStereo(0, 0.3, 3, &a, &unused);
-  (*blurred)->RenderStereo(0, 0.3, 3, &b, &unused);
+  (*sharp)->RenderStereo(0, 3.0, 30, &a, &unused);
+  (*blurred)->RenderStereo(0, 3.0, 30, &b, &unused);
   ASSERT_EQ(a.size(), b.size());
   auto energy = [](const std::vector<uint8_t>& img) {
     double e = 0.0;

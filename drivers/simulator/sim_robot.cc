@@ -1,5 +1,6 @@
 #include "drivers/simulator/sim_robot.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -133,8 +134,12 @@ SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int ind
   const double speed = 1.0, altitude = rng.Uniform(3.5, 5.0);
   const int n = static_cast<int>(std::ceil(duration / kKnot)) + 4;
   std::vector<Eigen::Vector3d> pos, euler;
+  // It hovers after take-off before it sets out, as a survey flight does (and as the filter's static
+  // initialization needs: a multicopter in flight is never still).
+  const double hover = 2.0;  // s
+  const auto th_at = [&](int i) { return phase + speed * std::max(0.0, kKnot * (i - 1) - hover) / R0; };
   for (int i = 0; i < n; ++i) {
-    const double th = phase + speed * kKnot * (i - 1) / R0;
+    const double th = th_at(i);
     const Eigen::Vector2d p = R0 * Eigen::Vector2d(std::cos(th), 0.6 * std::sin(2 * th) + std::sin(th) * 0.4);
     double ground = terrain.Height(p.x(), p.y());
     pos.emplace_back(p.x(), p.y(), ground + altitude + 0.5 * std::sin(3 * th));
@@ -146,7 +151,10 @@ SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int ind
     const Eigen::Vector3d acc = i > 0 && i < n - 1
                                     ? Eigen::Vector3d((pos[b] - 2 * pos[static_cast<size_t>(i)] + pos[a]) / (kKnot * kKnot))
                                     : Eigen::Vector3d::Zero();
-    const double yaw = std::atan2(vel.y(), vel.x());
+    // Hovering, it already faces along the path (its tangent at the start).
+    const double th = th_at(i);
+    const Eigen::Vector2d tangent(-std::sin(th), 1.2 * std::cos(2 * th) + 0.4 * std::cos(th));
+    const double yaw = vel.head<2>().norm() > 1e-6 ? std::atan2(vel.y(), vel.x()) : std::atan2(tangent.y(), tangent.x());
     const Eigen::Vector2d acc_body = Eigen::Rotation2Dd(-yaw) * acc.head<2>();
     euler.emplace_back(yaw, std::atan2(acc_body.x(), 9.81), -std::atan2(acc_body.y(), 9.81));
   }

@@ -1,0 +1,32 @@
+#pragma once
+// `stereo:` in a cairnd profile: dense matching of rectified pairs for mapping (thesis 3.1, 5.1).
+// The backend switch picks the FPGA offload or the SIMD CPU kernel (same disparities bit for bit in
+// raster_paths mode); `device: sim` drives the cycle-accurate simulation of the board through the
+// unchanged host driver (hardware-in-the-loop benches without a board; slow, small images only).
+
+#include <cstdint>
+
+#include "fpga/sgm_options.h"
+#include "fpga/stereo_backend_switch.h"
+#include "hal/options_visitor.h"
+
+namespace cairn {
+
+struct DenseStereoOptions {
+  bool enabled = false;
+  // Dense matching runs on every Nth rectified pair; the odometry still sees every pair.
+  int64_t every_nth_frame = 2;
+  StereoBackendOptions backend;  // keys backend, device, timeout_ms sit directly under stereo:
+  SgmOptions sgm;
+
+  void Visit(OptionsVisitor& v) {
+    v.Flag("enabled", enabled);
+    v.Integer("every_nth_frame", every_nth_frame, 1, 1000, "frames");
+    backend.Visit(v);
+    v.Section("sgm", sgm);
+  }
+  // Device path of the simulated board.
+  static constexpr const char* kSimulatedDevice = "sim";
+};
+
+}  // namespace cairn
