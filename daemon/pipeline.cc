@@ -37,7 +37,12 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
-      stereo_stats_(rates.camera_hz) {}
+      stereo_stats_(rates.camera_hz) {
+  // spdlog creates its default logger on first use, inside its uninstrumented shared library, so
+  // ThreadSanitizer cannot see that construction is ordered before the other threads' reads.
+  // Creating it here, before any thread logs through the pipeline, makes the order explicit.
+  spdlog::default_logger_raw();
+}
 
 Pipeline::~Pipeline() { StopAndDrain(); }
 
