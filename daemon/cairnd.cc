@@ -44,7 +44,7 @@ void Cairnd::BlockTerminationSignals() {
 }
 
 Status Cairnd::Prepare() {
-  wheel_odometry_ = options_.can.enabled;  // a simulated robot overrides it below
+  if (options_.can.enabled) wheel_calibration_ = CanWheelDecoder(options_.can).calibration();
   if (options_.source == SourceKind::kReplay) {
     if (options_.replay.dataset.empty()) {
       return InvalidArgumentError(config_path_ + ": replay.dataset is empty; give a dataset with --replay DIR");
@@ -58,6 +58,18 @@ Status Cairnd::Prepare() {
           return InvalidArgumentError(f + ": replaying a recording into its own folder with recording "
                                           "enabled would overwrite it; choose another --out");
         }
+      }
+      // The first file's calibration: cairnd writes the same one into every file of a recording.
+      auto calibration = McapReplay::ReadCalibration(files->front());
+      if (!calibration.ok()) return calibration.status();
+      if (*calibration) {
+        stereo_calibration_ = (*calibration)->stereo;
+        imu_calibration_ = (*calibration)->imu;
+        camera_rate_hz_ = (*calibration)->camera_rate_hz;
+        wheel_calibration_ = (*calibration)->wheels;
+      } else {
+        spdlog::warn("{}: the recording carries no calibration (made by an older cairnd): its sensors replay "
+                     "and are recorded again, but nothing is estimated", files->front());
       }
       sources_.push_back(std::make_unique<McapReplay>(*files, options_.replay));
     }
@@ -80,7 +92,11 @@ Status Cairnd::Prepare() {
     stereo_calibration_ = robot->stereo;
     imu_calibration_ = robot->imu;
     camera_rate_hz_ = robot->camera_rate_hz;
-    wheel_odometry_ = robot->has_wheels;
+    if (robot->has_wheels) {
+      wheel_calibration_ = CanWheelDecoder(options_.can).calibration();
+    } else {
+      wheel_calibration_.reset();
+    }
     ground_truth_ = std::move(robot->ground_truth);
     sources_.push_back(std::move(robot->source));
   }
@@ -123,7 +139,7 @@ int Cairnd::Run() {
     EstimationSetup setup;
     setup.imu = *imu_calibration_;
     setup.stereo = *stereo_calibration_;
-    if (wheel_odometry_) setup.wheels = CanWheelDecoder(options_.can).calibration();
+    if (wheel_calibration_) setup.wheels = *wheel_calibration_;
     setup.filter = options_.filter;
     setup.vo = options_.vo;
     setup.frame_switch = options_.frame_switch;
@@ -149,7 +165,19 @@ int Cairnd::Run() {
   if (options_.recording.enabled || options_.live.enabled) {
     telemetry = std::make_unique<TelemetryStage>(options_.executors.telemetry,
                                                  static_cast<size_t>(options_.queues.telemetry), deterministic);
-    if (options_.recording.enabled) telemetry->EnableRecording(options_.output.dir, options_.recording);
+    if (options_.recording.enabled) {
+      std::string calibration;
+      if (stereo_calibration_ && imu_calibration_) {
+        RecordedCalibration c;
+        c.robot = options_.robot.name;
+        c.stereo = *stereo_calibration_;
+        c.camera_rate_hz = camera_rate_hz_;
+        c.imu = *imu_calibration_;
+        c.wheels = wheel_calibration_;
+        calibration = c.Encode();
+      }
+      telemetry->EnableRecording(options_.output.dir, options_.recording, std::move(calibration));
+    }
     if (options_.live.enabled) {
       if (Status s = telemetry->EnableLiveStream(options_.robot.name, options_.live); !s.ok()) {
         // Degrade: no live view, everything else runs.

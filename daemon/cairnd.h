@@ -37,8 +37,9 @@ class Cairnd {
   std::optional<StereoCalibration> stereo_calibration_;
   std::optional<ImuCalibration> imu_calibration_;
   double camera_rate_hz_ = 0.0;
-  // Wheel odometry arrives in the configured CAN layout (a bus, a recording of one, a simulated rover).
-  bool wheel_odometry_ = false;
+  // Where wheels are known: the configured CAN layout's contact points (a bus, a simulated rover),
+  // or the recorded ones when a recording carries its calibration.
+  std::optional<WheelCalibration> wheel_calibration_;
   // Simulated runs: the robot's true trajectory, written as ground_truth.tum for evaluation.
   std::optional<Trajectory> ground_truth_;
   std::vector<std::unique_ptr<SensorSourceInterface>> sources_;

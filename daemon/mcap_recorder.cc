@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "cairn/calibration.pb.h"
 #include "daemon/protobuf_schema.h"
 
 namespace cairn {
@@ -11,7 +12,7 @@ McapRecorder::McapRecorder(std::string directory, RecordingOptions options)
 
 McapRecorder::~McapRecorder() { (void)Close(); }
 
-Status McapRecorder::EnsureOpen() {
+Status McapRecorder::EnsureOpen(Timestamp time) {
   if (writer_.is_open()) return Status::Ok();
   char name[32];
   std::snprintf(name, sizeof(name), "recording-%03d.mcap", file_index_++);
@@ -38,12 +39,24 @@ Status McapRecorder::EnsureOpen() {
     if (!ch.ok()) return ch.status();
     channel_[t] = *ch;
   }
+  if (!calibration_.empty()) {
+    const auto* d = msg::Calibration::descriptor();
+    const std::string set = ProtobufFileDescriptorSet(d);
+    auto schema = writer_.AddSchema(d->full_name(), "protobuf", {reinterpret_cast<const uint8_t*>(set.data()), set.size()});
+    if (!schema.ok()) return schema.status();
+    auto ch = writer_.AddChannel("/calibration", "protobuf", *schema);
+    if (!ch.ok()) return ch.status();
+    const uint64_t ns = static_cast<uint64_t>(time.nanoseconds());
+    CAIRN_RETURN_IF_ERROR(writer_.Write(*ch, 0, ns, ns, {reinterpret_cast<const uint8_t*>(calibration_.data()),
+                                                        calibration_.size()}));
+    ++report_.messages["/calibration"];
+  }
   return Status::Ok();
 }
 
 Status McapRecorder::Write(TelemetryTopic topic, Timestamp time, const std::string& encoded) {
   const int t = static_cast<int>(topic);
-  Status s = EnsureOpen();
+  Status s = EnsureOpen(time);
   if (s.ok()) {
     const uint64_t ns = static_cast<uint64_t>(time.nanoseconds());
     s = writer_.Write(channel_[t], sequence_[t]++, ns, ns,

@@ -25,6 +25,10 @@ class McapRecorder {
   McapRecorder(std::string directory, RecordingOptions options);
   ~McapRecorder();
 
+  // The sensors' calibration (cairn.msg.Calibration, see drivers/recorded_calibration.h): written
+  // on /calibration at the start of every file, so each file replays with estimation on its own.
+  void SetCalibration(std::string encoded) { calibration_ = std::move(encoded); }
+
   Status Write(TelemetryTopic topic, Timestamp time, const std::string& encoded);
   // Closes the current file (writing its summary).
   Status Close();
@@ -32,10 +36,11 @@ class McapRecorder {
   const RecordingReport& report() const { return report_; }
 
  private:
-  Status EnsureOpen();
+  Status EnsureOpen(Timestamp time);
 
   std::string directory_;
   RecordingOptions options_;
+  std::string calibration_;
   McapWriter writer_;
   int file_index_ = 0;
   uint16_t channel_[kTelemetryTopicCount] = {};

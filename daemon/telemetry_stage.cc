@@ -22,8 +22,9 @@ TelemetryStage::TelemetryStage(const ExecutorOptions& executor, size_t queue_dep
 
 TelemetryStage::~TelemetryStage() { StopAndDrain(); }
 
-void TelemetryStage::EnableRecording(std::string directory, const RecordingOptions& options) {
+void TelemetryStage::EnableRecording(std::string directory, const RecordingOptions& options, std::string calibration) {
   recorder_ = std::make_unique<McapRecorder>(std::move(directory), options);
+  recorder_->SetCalibration(std::move(calibration));
   recording_images_ = options.images;
 }
 

@@ -33,7 +33,8 @@ class TelemetryStage {
   TelemetryStage(const ExecutorOptions& executor, size_t queue_depth, bool deterministic);
   ~TelemetryStage();
 
-  void EnableRecording(std::string directory, const RecordingOptions& options);
+  // `calibration`: the encoded sensor calibration each recording file starts with (empty: none known).
+  void EnableRecording(std::string directory, const RecordingOptions& options, std::string calibration = {});
   Status EnableLiveStream(const std::string& robot_name, const LiveStreamOptions& options);
 
   void Start();

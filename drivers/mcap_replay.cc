@@ -105,6 +105,26 @@ Expected<std::vector<std::string>> McapReplay::FindRecordings(const std::string&
   return files;
 }
 
+Expected<std::optional<RecordedCalibration>> McapReplay::ReadCalibration(const std::string& file) {
+  McapReader reader(file);
+  std::optional<RecordedCalibration> calibration;
+  Status decode = Status::Ok();
+  auto scan = reader.Scan(
+      [&](const McapChannel& c, const McapMessageView& m) {
+        if (c.topic != "/calibration") return;
+        auto decoded = RecordedCalibration::Decode(m.data, file + " /calibration");
+        if (decoded.ok()) {
+          calibration = std::move(*decoded);
+        } else {
+          decode = decoded.status();
+        }
+      },
+      [] { return true; });  // it is the first message when there is one
+  if (!scan.ok()) return scan.status();
+  if (!decode.ok()) return decode;
+  return calibration;
+}
+
 McapReplay::McapReplay(std::vector<std::string> files, ReplayOptions options)
     : files_(std::move(files)), options_(std::move(options)), clock_(options_) {}
 

@@ -4,10 +4,12 @@
 // pipeline consumed them, so a deterministic recording replays to the same results.
 
 #include <atomic>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "drivers/recorded_calibration.h"
 #include "drivers/replay_clock.h"
 #include "drivers/replay_options.h"
 #include "hal/sensor_source_interface.h"
@@ -29,6 +31,10 @@ class McapReplay final : public SensorSourceInterface {
 
   // True for a file or folder that looks like an MCAP recording rather than an EuRoC folder.
   static bool IsRecording(const std::string& path);
+
+  // The calibration a recording file starts with (cairnd writes it on /calibration before any
+  // sample); none for recordings made without one. A calibration that does not decode is an error.
+  static Expected<std::optional<RecordedCalibration>> ReadCalibration(const std::string& file);
 
  private:
   void Run(std::stop_token stop);

@@ -1,6 +1,7 @@
 // Recording to MCAP and replaying recordings: what cairnd consumed is what it recorded, a replay
-// of a deterministic recording reproduces the run (and the recorded sensor messages) byte for byte,
-// rotation splits files without losing samples, and a recording cut short by SIGKILL still replays.
+// of a deterministic recording re-estimates with the recorded calibration and reproduces the run
+// (every recorded message, the trajectories and the maps) byte for byte, rotation splits files
+// without losing samples, and a recording cut short by SIGKILL still replays.
 
 #include <signal.h>
 
@@ -11,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "drivers/mcap/mcap_reader.h"
+#include "drivers/mcap/mcap_writer.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
@@ -24,15 +26,17 @@ using testing::JsonValue;
 std::string Cairnd() { return testing::BinaryDir() + "/daemon/cairnd"; }
 std::string Config() { return testing::SourceDir() + "/configs/euroc.yaml"; }
 
-// The sensor messages of a recording in file order, one line each (topic, log time, size and a
-// hash of the bytes): what a replay of it must record again. The estimates (/pose, /tf) are left
-// out: a recording does not carry the sensors' calibration yet, so its replay does not re-run the
-// estimation chain.
-std::vector<std::string> SensorMessages(const std::string& path) {
+bool IsSensorTopic(const std::string& topic) {
+  return topic == "/imu" || topic == "/wheel_odometry" || topic == "/stereo/info" || topic.starts_with("/cam");
+}
+
+// The messages of a recording in file order, one line each (topic, log time, size and a hash of
+// the bytes); `sensors_only` keeps the raw samples a replay consumes.
+std::vector<std::string> Messages(const std::string& path, bool sensors_only = false) {
   std::vector<std::string> out;
   McapReader reader(path);
   auto scan = reader.Scan([&](const McapChannel& c, const McapMessageView& m) {
-    if (c.topic == "/pose" || c.topic == "/tf" || c.topic.starts_with("/map/")) return;
+    if (sensors_only && !IsSensorTopic(c.topic)) return;
     uint64_t h = 1469598103934665603ull;  // FNV-1a
     for (uint8_t b : m.data) h = (h ^ b) * 1099511628211ull;
     out.push_back(c.topic + " " + std::to_string(m.log_time) + " " + std::to_string(m.data.size()) + " " +
@@ -40,6 +44,46 @@ std::vector<std::string> SensorMessages(const std::string& path) {
   });
   EXPECT_TRUE(scan.ok()) << path << ": " << scan.status().ToString();
   return out;
+}
+
+std::string FileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in.good()) << "cannot read " << path;
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Copies a recording, replacing its /calibration message by `calibration` (dropped when empty):
+// what an older cairnd wrote, or a damaged file.
+void RewriteCalibration(const std::string& from, const std::string& to, const std::string& calibration) {
+  McapReader reader(from);
+  ASSERT_TRUE(reader.Scan(nullptr).ok()) << from;
+  // Channels first, as cairnd writes them.
+  McapWriter writer;
+  ASSERT_TRUE(writer.Open(to, McapWriterOptions{}).ok()) << to;
+  std::map<uint16_t, uint16_t> schema_of, channel_of;
+  for (const auto& [id, c] : reader.channels()) {
+    if (c.topic == "/calibration" && calibration.empty()) continue;
+    if (schema_of.count(c.schema_id) == 0) {
+      const McapSchema& s = reader.schemas().at(c.schema_id);
+      schema_of[c.schema_id] = *writer.AddSchema(s.name, s.encoding, s.data);
+    }
+    channel_of[id] = *writer.AddChannel(c.topic, c.message_encoding, schema_of[c.schema_id]);
+  }
+  uint64_t written = 0;
+  auto scan = reader.Scan([&](const McapChannel& c, const McapMessageView& m) {
+    if (c.topic == "/calibration" && calibration.empty()) return;
+    const std::span<const uint8_t> data =
+        c.topic == "/calibration" ? std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(calibration.data()),
+                                                             calibration.size())
+                                  : m.data;
+    ASSERT_TRUE(writer.Write(channel_of[c.id], m.sequence, m.log_time, m.publish_time, data).ok());
+    ++written;
+  });
+  ASSERT_TRUE(scan.ok()) << scan.status().ToString();
+  ASSERT_GT(written, 0u);
+  ASSERT_TRUE(writer.Close().ok());
 }
 
 testing::ProcessResult RunCairnd(const std::string& input, const std::string& out,
@@ -84,9 +128,37 @@ TEST_F(CairndRecordingTest, ReplayOfARecordingReproducesTheRunAndTheRecording) {
   EXPECT_TRUE(b["complete"].boolean());
   EXPECT_EQ(rec["messages"]["/pose"].number(), a["estimation"]["trajectory_poses"].number());
   EXPECT_EQ(rec["messages"]["/tf"].number(), a["estimation"]["trajectory_poses"].number());
-  const auto sensors = SensorMessages(dir_ + "/a/recording-000.mcap");
-  EXPECT_EQ(sensors.size(), 29120u + 3u * 95u);
-  EXPECT_EQ(sensors, SensorMessages(dir_ + "/b/recording-000.mcap"));
+  EXPECT_EQ(rec["messages"]["/calibration"].number(), 1);
+  EXPECT_GT(a["estimation"]["trajectory_poses"].number(), 50);
+  // The replay ran the estimation chain again, with the recorded calibration, to the same bits.
+  EXPECT_EQ(b["estimation"]["trajectory_poses"].number(), a["estimation"]["trajectory_poses"].number());
+  EXPECT_EQ(Messages(dir_ + "/a/recording-000.mcap", true).size(), 29120u + 3u * 95u);
+  EXPECT_EQ(Messages(dir_ + "/a/recording-000.mcap"), Messages(dir_ + "/b/recording-000.mcap"));
+  for (const char* f : {"recording-000.mcap", "trajectory.tum", "vo.tum"}) {
+    EXPECT_TRUE(FileBytes(dir_ + "/a/" + f) == FileBytes(dir_ + "/b/" + f)) << f << " differs";
+  }
+}
+
+// A recording made without a calibration (an older cairnd) still replays its sensors, with a
+// warning, and estimates nothing; a calibration that does not decode is refused naming the file.
+TEST_F(CairndRecordingTest, RecordingsWithoutOrWithBadCalibration) {
+  ASSERT_EQ(RunCairnd(testing::EurocMicro(), dir_ + "/a", {"--set", "recording.compression=lz4"}).exit_code, 0);
+  fs::create_directories(dir_ + "/old");
+  RewriteCalibration(dir_ + "/a/recording-000.mcap", dir_ + "/old/recording-000.mcap", "");
+  const auto old = RunCairnd(dir_ + "/old/recording-000.mcap", dir_ + "/old-replay");
+  ASSERT_EQ(old.exit_code, 0) << old.output;
+  EXPECT_NE(old.output.find("carries no calibration"), std::string::npos) << old.output;
+  const JsonValue o = JsonValue::ParseFile(dir_ + "/old-replay/summary.json");
+  EXPECT_EQ(o["streams"]["stereo"]["count"].number(), 95);
+  EXPECT_FALSE(o.has("estimation") && o["estimation"].has("trajectory_poses") &&
+               o["estimation"]["trajectory_poses"].number() > 0);
+  EXPECT_EQ(Messages(dir_ + "/a/recording-000.mcap", true), Messages(dir_ + "/old-replay/recording-000.mcap", true));
+
+  fs::create_directories(dir_ + "/bad");
+  RewriteCalibration(dir_ + "/a/recording-000.mcap", dir_ + "/bad/recording-000.mcap", "\xff\xff not a message");
+  const auto bad = RunCairnd(dir_ + "/bad/recording-000.mcap", dir_ + "/bad-replay");
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("bad/recording-000.mcap /calibration"), std::string::npos) << bad.output;
 }
 
 // PNG recordings are lossless: replaying one and recording raw gives the raw recording of the
@@ -101,7 +173,7 @@ TEST_F(CairndRecordingTest, CompressedImagesReplayPngBitExactAndJpegSmall) {
   EXPECT_FALSE(p["recording"]["messages"].has("/cam0/image"));
   const auto again = RunCairnd(dir_ + "/png/recording-000.mcap", dir_ + "/png-raw");
   ASSERT_EQ(again.exit_code, 0) << again.output;
-  EXPECT_EQ(SensorMessages(dir_ + "/raw/recording-000.mcap"), SensorMessages(dir_ + "/png-raw/recording-000.mcap"));
+  EXPECT_EQ(Messages(dir_ + "/raw/recording-000.mcap"), Messages(dir_ + "/png-raw/recording-000.mcap"));
 
   const auto jpeg = RunCairnd(testing::EurocMicro(), dir_ + "/jpeg",
                               {"--set", "recording.images.format=jpeg", "--set", "recording.images.jpeg_quality=90"});
@@ -166,6 +238,32 @@ TEST_F(CairndRecordingTest, BadRecordingsAreRefusedBeforeAnythingIsWritten) {
   const auto self = RunCairnd(dir_ + "/self", dir_ + "/self");
   EXPECT_EQ(self.exit_code, 1);
   EXPECT_NE(self.output.find("overwrite"), std::string::npos) << self.output;
+}
+
+// A simulated rover (wheels, dense stereo, mapping, frame switches made by submap partitioning):
+// the replay of its recording reproduces every estimate, submap and map byte for byte.
+TEST(CairndRecordingSimTest, SimulatedRoverRecordingReplaysToTheSameEstimatesAndMaps) {
+  const std::string dir = testing::FreshTempDir("recording-sim");
+  const std::string config = testing::SourceDir() + "/configs/rover.yaml";
+  const std::vector<std::string> common = {"--set", "replay.pacing=fast", "--set", "replay.deterministic=true",
+                                           "--set", "recording.enabled=true", "--set", "recording.images.format=png",
+                                           "--set", "live.enabled=false"};
+  std::vector<std::string> sim = {Cairnd(), "--config", config, "--sim", "--out", dir + "/a", "--set", "sim.duration=6"};
+  sim.insert(sim.end(), common.begin(), common.end());
+  const auto a = testing::RunProcess(sim);
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  std::vector<std::string> replay = {Cairnd(), "--config", config, "--replay", dir + "/a/recording-000.mcap",
+                                     "--out", dir + "/b"};
+  replay.insert(replay.end(), common.begin(), common.end());
+  const auto b = testing::RunProcess(replay);
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const JsonValue sa = JsonValue::ParseFile(dir + "/a/summary.json");
+  EXPECT_GT(sa["streams"]["wheel_odometry"]["count"].number(), 500);
+  EXPECT_GE(sa["mapping"]["submaps"]["written"].number(), 1);
+  EXPECT_EQ(Messages(dir + "/a/recording-000.mcap"), Messages(dir + "/b/recording-000.mcap"));
+  for (const char* f : {"trajectory.tum", "vo.tum", "map.ply", "map.bt", "obstacles.png", "submaps/rover-000000.submap"}) {
+    EXPECT_TRUE(FileBytes(dir + "/a/" + f) == FileBytes(dir + "/b/" + f)) << f << " differs";
+  }
 }
 
 }  // namespace
