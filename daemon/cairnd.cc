@@ -17,6 +17,7 @@
 #include "drivers/euroc_replay.h"
 #include "drivers/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
+#include "estimation/g2o_io.h"
 
 namespace cairn {
 namespace {
@@ -149,6 +150,12 @@ int Cairnd::Run() {
       spdlog::error("{}: {}", options_.source == SourceKind::kSim ? "sim" : options_.replay.dataset, s.ToString());
       return 1;
     }
+    if (options_.graph.enabled && options_.vo.enabled) {
+      if (Status s = pipeline.EnableGraph(options_.graph); !s.ok()) {
+        spdlog::error("{}: {}", config_path_, s.ToString());
+        return 1;
+      }
+    }
     if (options_.mapping.enabled && options_.vo.enabled) {
       MappingSetup mapping;
       mapping.robot = options_.robot.name;
@@ -280,6 +287,22 @@ int Cairnd::Run() {
   return 0;
 }
 
+Status Cairnd::WriteTrajectory(const std::string& stem, const Trajectory& trajectory) const {
+  for (const std::string& name : options_.output.TrajectoryFormatList()) {
+    if (name == "tum") {
+      CAIRN_RETURN_IF_ERROR(WriteFileAtomically(stem + ".tum", TrajectoryIo::Format(trajectory, TrajectoryFormat::kTum)));
+    } else if (name == "euroc") {
+      CAIRN_RETURN_IF_ERROR(
+          WriteFileAtomically(stem + ".csv", TrajectoryIo::Format(trajectory, TrajectoryFormat::kEurocCsv)));
+    } else {
+      CAIRN_RETURN_IF_ERROR(
+          WriteFileAtomically(stem + ".kitti", TrajectoryIo::Format(trajectory, TrajectoryFormat::kKitti)));
+      CAIRN_RETURN_IF_ERROR(WriteFileAtomically(stem + "_times.txt", TrajectoryIo::KittiTimes(trajectory)));
+    }
+  }
+  return Status::Ok();
+}
+
 Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
   const std::string dir = options_.output.dir;
   CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/config.yaml", "# effective configuration of this run (from " +
@@ -293,10 +316,16 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
   if (pipeline.trajectory() != nullptr) {
     // Body pose per camera frame: the filter's, chained through its frame switches into the
     // first local frame; and the raw odometry chain.
-    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/trajectory.tum",
-                                              TrajectoryIo::Format(*pipeline.trajectory(), TrajectoryFormat::kTum)));
+    CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/trajectory", *pipeline.trajectory()));
     CAIRN_RETURN_IF_ERROR(
         WriteFileAtomically(dir + "/vo.tum", TrajectoryIo::Format(*pipeline.odometry(), TrajectoryFormat::kTum)));
+  }
+  if (const GraphStage* graph = pipeline.graph()) {
+    // The same estimates placed by the graph's optimized submap origins.
+    CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory", graph->GlobalTrajectory()));
+    if (options_.graph.write_g2o) {
+      CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/graph.g2o", FormatG2o(graph->ExportPoseGraph())));
+    }
   }
   // Last: its presence means the run's outputs are complete.
   return WriteFileAtomically(dir + "/summary.json", BuildSummaryJson(run, pipeline));

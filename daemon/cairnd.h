@@ -29,6 +29,8 @@ class Cairnd {
 
  private:
   Status WriteOutputs(const struct RunInfo& run, const class Pipeline& pipeline);
+  // `stem` + .tum / .csv / .kitti (+ _times.txt), for each of output.trajectory_formats.
+  Status WriteTrajectory(const std::string& stem, const Trajectory& trajectory) const;
 
   CairndOptions options_;
   std::string config_path_;

@@ -15,6 +15,13 @@ Expected<CairndOptions> LoadCairndOptions(const std::string& path,
     return InvalidArgumentError(path + ": mapping.enabled needs stereo.enabled (dense depth) and vo.enabled "
                                        "(the filter's poses)");
   }
+  if (options.graph.enabled && !options.vo.enabled) {
+    return InvalidArgumentError(path + ": graph.enabled needs vo.enabled (the filter's estimates and frame switches)");
+  }
+  if (options.graph.optimizer.own_robot < 'a' || options.graph.optimizer.own_robot > 'z') {
+    return InvalidArgumentError(path + ": graph.optimizer.own_robot must be one lower-case letter (the robot's "
+                                       "letter in graph keys)");
+  }
   return options;
 }
 

@@ -2,11 +2,14 @@
 // Everything cairnd reads from its YAML configuration. Every key is required (a shipped profile is
 // complete and explicit); `cairn config doc` prints them all with units and ranges.
 
+#include <algorithm>
 #include <cctype>
 #include <string>
+#include <vector>
 
 #include "daemon/dense_stereo_options.h"
 #include "daemon/executor_options.h"
+#include "daemon/graph_stage_options.h"
 #include "daemon/live_stream_options.h"
 #include "daemon/mapping_stage_options.h"
 #include "daemon/recording_options.h"
@@ -53,10 +56,37 @@ struct DaemonOptions {
 struct OutputOptions {
   // Where summary.json and the other run outputs go; --out overrides it.
   std::string dir = "out";
+  // Trajectory files, comma separated: tum (.tum), euroc (.csv, EuRoC ground-truth columns),
+  // kitti (.kitti, 3x4 matrices, with _times.txt).
+  std::string trajectory_formats = "tum";
 
-  void Visit(OptionsVisitor& v) { v.Text("dir", dir); }
+  void Visit(OptionsVisitor& v) {
+    v.Text("dir", dir);
+    v.Text("trajectory_formats", trajectory_formats);
+  }
   Status Validate() const {
-    return dir.empty() ? InvalidArgumentError("dir must not be empty") : Status::Ok();
+    if (dir.empty()) return InvalidArgumentError("dir must not be empty");
+    if (TrajectoryFormatList().empty()) {
+      return InvalidArgumentError("trajectory_formats: '" + trajectory_formats +
+                                  "' names none of tum, euroc, kitti (comma separated)");
+    }
+    return Status::Ok();
+  }
+  // The formats asked for, in order; empty when any name is unknown.
+  std::vector<std::string> TrajectoryFormatList() const {
+    std::vector<std::string> out;
+    size_t start = 0;
+    while (start <= trajectory_formats.size()) {
+      size_t end = trajectory_formats.find(',', start);
+      if (end == std::string::npos) end = trajectory_formats.size();
+      std::string name = trajectory_formats.substr(start, end - start);
+      name.erase(0, name.find_first_not_of(' '));
+      name.erase(name.find_last_not_of(' ') + 1);
+      if (name != "tum" && name != "euroc" && name != "kitti") return {};
+      if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+      start = end + 1;
+    }
+    return out;
   }
 };
 
@@ -77,6 +107,7 @@ struct CairndOptions {
   FrameSwitchOptions frame_switch;
   DenseStereoOptions stereo;
   MappingStageOptions mapping;
+  GraphStageOptions graph;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -96,6 +127,7 @@ struct CairndOptions {
     v.Section("frame_switch", frame_switch);
     v.Section("stereo", stereo);
     v.Section("mapping", mapping);
+    v.Section("graph", graph);
   }
 };
 

@@ -102,6 +102,7 @@ void EstimationStage::Emit(const PendingFrame& f) {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pose.covariance.topLeftCorner<3, 3>());
     e.position_sigma = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
     e.position_covariance = pose.covariance.topLeftCorner<3, 3>();
+    e.pose_covariance = pose.covariance;
   }
   if (estimates_->TryPush(e)) {
     ++report_.estimates_emitted;
@@ -109,6 +110,11 @@ void EstimationStage::Emit(const PendingFrame& f) {
     ++report_.estimates_dropped;
   }
   if (mapping_estimates_ != nullptr && !mapping_estimates_->TryPush(e)) ++report_.mapping_estimates_dropped;
+  if (graph_inputs_ != nullptr && e.valid) {
+    graph_input_.kind = GraphInput::Kind::kEstimate;
+    graph_input_.estimate = e;
+    if (!graph_inputs_->TryPush(graph_input_)) ++report_.graph_inputs_dropped;
+  }
 }
 
 void EstimationStage::OnFrameSwitch(const FilterSwitchRequest& request) {
@@ -122,6 +128,11 @@ void EstimationStage::OnFrameSwitch(const FilterSwitchRequest& request) {
   if (switch_events_ != nullptr &&
       !switch_events_->TryPush(FrameSwitchEvent{r.time, r.old_frame_id, r.new_frame_id, r.transform})) {
     ++report_.switch_events_dropped;
+  }
+  if (graph_inputs_ != nullptr) {
+    graph_input_.kind = GraphInput::Kind::kFrameSwitch;
+    graph_input_.frame_switch = FrameSwitchEvent{r.time, r.old_frame_id, r.new_frame_id, r.transform};
+    if (!graph_inputs_->TryPush(graph_input_)) ++report_.graph_inputs_dropped;
   }
 }
 

@@ -28,6 +28,7 @@ struct FrameEstimate {
   Eigen::Isometry3d T_first_body = Eigen::Isometry3d::Identity();  // chained through switches
   double position_sigma = 0.0;  // m, largest standard deviation of the position
   Eigen::Matrix3d position_covariance = Eigen::Matrix3d::Zero();  // m^2, in the local frame
+  Matrix6d pose_covariance = Matrix6d::Zero();  // [position; attitude (right perturbation)] of the IMU
   VoStatus vo_status = VoStatus::kNoKeyframe;
   // The keyframe the odometry used has no clone in the filter (filter not yet initialized, or the
   // clone is gone): the odometry must stop using it.
@@ -51,6 +52,14 @@ struct FrameSwitchEvent {
   FrameTransform transform;
 };
 
+// What the estimation thread hands the graph, in its order: a filter estimate or a frame switch.
+struct GraphInput {
+  enum class Kind : uint8_t { kEstimate, kFrameSwitch };
+  Kind kind = Kind::kEstimate;
+  FrameEstimate estimate;
+  FrameSwitchEvent frame_switch;
+};
+
 struct EstimationReport {
   FilterCounters filter;
   uint64_t vo_results = 0;
@@ -64,6 +73,7 @@ struct EstimationReport {
   uint64_t estimates_dropped = 0;  // output queue full
   uint64_t mapping_estimates_dropped = 0;
   uint64_t switch_events_dropped = 0;
+  uint64_t graph_inputs_dropped = 0;
   bool initialized = false;
 };
 
@@ -83,6 +93,8 @@ class EstimationStage {
     mapping_estimates_ = estimates;
     switch_events_ = switches;
   }
+  // Valid estimates and the frame switches, in one queue so the graph sees them in their order.
+  void PublishToGraph(SpscQueue<GraphInput>* inputs) { graph_inputs_ = inputs; }
 
   bool initialized() const { return filter_.initialized(); }
   EstimationReport report() const;
@@ -107,6 +119,8 @@ class EstimationStage {
   SpscQueue<FrameEstimate>* estimates_;
   SpscQueue<FrameEstimate>* mapping_estimates_ = nullptr;
   SpscQueue<FrameSwitchEvent>* switch_events_ = nullptr;
+  SpscQueue<GraphInput>* graph_inputs_ = nullptr;
+  GraphInput graph_input_;  // scratch: the estimate is copied in, not built on the real-time stack
   std::array<CloneEntry, 64> clones_{};
   size_t next_clone_slot_ = 0;
   std::array<PendingFrame, 32> pending_{};

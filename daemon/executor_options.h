@@ -42,6 +42,7 @@ struct ExecutorsOptions {
   // mapping; apart from the stereo executor so the odometry never waits for dense matching.
   ExecutorOptions mapping;
   ExecutorOptions telemetry;   // recording and the live stream
+  ExecutorOptions graph;       // the SLAM graph's online optimization (low priority)
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
@@ -49,6 +50,7 @@ struct ExecutorsOptions {
     v.Section("vo", vo);
     v.Section("mapping", mapping);
     v.Section("telemetry", telemetry);
+    v.Section("graph", graph);
   }
 };
 
@@ -63,6 +65,8 @@ struct QueueOptions {
   int64_t dense = 2;
   // Samples waiting for the telemetry executor (recording, live stream); IMU gets 8x this.
   int64_t telemetry = 64;
+  // Filter estimates and frame switches waiting for the graph (about 400 s of frames at 10 Hz).
+  int64_t graph = 4096;
 
   void Visit(OptionsVisitor& v) {
     v.Integer("imu", imu, 2, 1 << 20, "samples");
@@ -71,6 +75,7 @@ struct QueueOptions {
     v.Integer("vo", vo, 2, 1024, "frames");
     v.Integer("dense", dense, 2, 1024, "frames");
     v.Integer("telemetry", telemetry, 2, 1 << 20, "samples");
+    v.Integer("graph", graph, 2, 1 << 20, "items");
   }
 };
 

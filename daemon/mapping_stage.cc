@@ -219,10 +219,11 @@ void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   report_.submap_bytes += bytes->size();
 }
 
-void MappingStage::Finish() {
+void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins) {
   ProcessReady(/*final=*/true);
   ApplySwitchesUpTo(UINT64_MAX);
   Keep(mapper_.FinishOpenSubmap());
+  if (graph_origins != nullptr && !T_first_frame_.empty()) PlaceByGraph(*graph_origins);
   composer_.Update();
   const std::vector<CloudPoint> cloud = composer_.Cloud();
   const std::unique_ptr<octomap::OcTree> tree = composer_.Octree();
@@ -237,6 +238,26 @@ void MappingStage::Finish() {
   }
   if (Status s = MapExporter::WriteGridMap(mapper_.obstacle_map().Snapshot(), dir + "/obstacles.png"); !s.ok()) {
     Error(s.ToString());
+  }
+}
+
+void MappingStage::PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins) {
+  // The map's frame stays the first mapped frame; the graph places every submap relative to it.
+  const auto base = origins.find(T_first_frame_.begin()->first);
+  if (base == origins.end()) {
+    Error("the graph has no origin for the map's first frame; the map keeps the chain of frame switches");
+    return;
+  }
+  const Eigen::Isometry3d T_map_global = base->second.inverse();
+  for (const auto& [id, chained] : T_first_frame_) {
+    const auto origin = origins.find(id);
+    if (origin == origins.end()) continue;  // no submap began there, or the graph lost the frame
+    const Status s = composer_.SetPose(SubmapRef{setup_.robot, id}, T_map_global * origin->second);
+    if (s.ok()) {
+      ++report_.submaps_placed_by_graph;
+    } else if (s.code() != StatusCode::kNotFound) {
+      Error(s.ToString());
+    }
   }
 }
 

@@ -59,6 +59,7 @@ struct MappingStageReport {
   uint64_t submap_bytes = 0;         // wire size of the written submaps
   uint64_t map_points = 0;           // composed cloud at the end
   uint64_t map_voxels = 0;           // composed occupancy voxels at the end
+  uint64_t submaps_placed_by_graph = 0;  // composed at the SLAM graph's origins
   LocalMapperStats mapper;
   std::vector<std::string> errors;   // the first few, verbatim
 };
@@ -75,8 +76,10 @@ class MappingStage {
   void OnFrameSwitch(const FrameSwitchEvent& e) { switches_.push_back(e); }
   // Maps every waiting image whose estimate is known. `final`: no more estimates will come.
   void ProcessReady(bool final);
-  // End of the run: maps what waits, finishes the open submap and writes the map exports.
-  void Finish();
+  // End of the run: maps what waits, finishes the open submap and writes the map exports. With
+  // `graph_origins` (T_global_frame per local frame, from the SLAM graph) the submaps are composed
+  // at the graph's optimized origins instead of along the chain of frame switches.
+  void Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins = nullptr);
   // Finished submaps and obstacle-map snapshots also go to recording and the live stream.
   void SetTelemetry(TelemetryStage* telemetry) { telemetry_ = telemetry; }
 
@@ -91,6 +94,7 @@ class MappingStage {
   void Map(const DepthImage& image, const FrameEstimate& e);
   void ApplySwitchesUpTo(uint64_t frame_id);
   void Keep(std::shared_ptr<const Submap> submap);
+  void PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins);
   void Error(const std::string& what);
 
   MappingSetup setup_;

@@ -29,11 +29,13 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       dense_queue_(static_cast<size_t>(queues.dense)),
       mapping_estimate_queue_(256),
       switch_event_queue_(16),
+      graph_queue_(static_cast<size_t>(queues.graph)),
       imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
       estimation_exec_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
       vo_("vo", executors.vo),
       mapping_exec_("mapping", executors.mapping),
+      graph_exec_("graph", executors.graph),
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
@@ -74,6 +76,14 @@ Status Pipeline::EnableMapping(const MappingSetup& setup) {
   return Status::Ok();
 }
 
+Status Pipeline::EnableGraph(const GraphStageOptions& options) {
+  if (started_) return FailedPreconditionError("EnableGraph() after Start()");
+  if (!estimation_) return FailedPreconditionError("the graph needs the estimation chain (vo.enabled)");
+  graph_ = std::make_unique<GraphStage>(options, deterministic_);
+  estimation_->PublishToGraph(&graph_queue_);
+  return Status::Ok();
+}
+
 void Pipeline::SetTelemetry(TelemetryStage* telemetry) {
   telemetry_ = telemetry;
   if (mapping_) mapping_->SetTelemetry(telemetry);
@@ -93,6 +103,7 @@ void Pipeline::Start() {
   stereo_.Start([this](std::stop_token stop) { StereoLoop(stop); });
   if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
   if (mapping_) mapping_exec_.Start([this](std::stop_token stop) { MappingLoop(stop); });
+  if (graph_) graph_exec_.Start([this](std::stop_token stop) { GraphLoop(stop); });
 }
 
 void Pipeline::StopAndDrain() {
@@ -118,10 +129,22 @@ void Pipeline::StopAndDrain() {
   estimation_exec_.RequestStop();
   estimation_signal_.Notify();
   estimation_exec_.Join();
+  // The graph takes everything the filter made, then solves to convergence.
+  if (graph_) {
+    graph_exec_.RequestStop();
+    graph_signal_.Notify();
+    graph_exec_.Join();
+    graph_->Finish();
+  }
   // What the filter emitted last is mapped too; the open submap is finished and the map written.
   if (mapping_) {
     TakeMappingInputs();
-    mapping_->Finish();
+    if (graph_) {
+      const auto origins = graph_->FrameOrigins();
+      mapping_->Finish(&origins);
+    } else {
+      mapping_->Finish();
+    }
   }
   // Estimates emitted after the odometry stopped.
   if (vo_stage_) {
@@ -254,6 +277,10 @@ void Pipeline::EstimationLoop(std::stop_token stop) {
       }
       worked = true;
       if (deterministic_) consumed_signal_.Notify();
+      if (graph_ && graph_queue_.pushed() != graph_inputs_seen_) {
+        graph_inputs_seen_ = graph_queue_.pushed();
+        graph_signal_.Notify();
+      }
     }
     if (stop.stop_requested() && imu_queue_.empty() && wheel_queue_.empty() && trigger_queue_.empty() &&
         clone_queue_.empty() && vo_result_queue_.empty() && switch_queue_.empty()) {
@@ -385,6 +412,22 @@ void Pipeline::MappingLoop(std::stop_token stop) {
   }
 }
 
+void Pipeline::GraphLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { graph_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = graph_signal_.sequence();
+    bool worked = false;
+    while (const GraphInput* in = graph_queue_.Front()) {
+      graph_->OnInput(*in);
+      graph_queue_.PopFront();
+      worked = true;
+    }
+    // The estimation thread has stopped before this is asked: its last inputs are in the queue.
+    if (stop.stop_requested() && graph_queue_.empty()) return;
+    if (!worked) graph_signal_.WaitChange(seen);
+  }
+}
+
 std::vector<QueueReport> Pipeline::queue_reports() const {
   const auto r = [](const char* name, const auto& q) {
     return QueueReport{name, q.capacity(), q.pushed(), q.dropped(), q.high_water()};
@@ -403,6 +446,7 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
       out.push_back(q);
     }
   }
+  if (graph_) out.push_back(r("graph", graph_queue_));
   return out;
 }
 
@@ -410,7 +454,7 @@ uint64_t Pipeline::total_dropped() const {
   return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
          rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
          estimate_queue_.dropped() + dense_queue_.dropped() + mapping_estimate_queue_.dropped() +
-         switch_event_queue_.dropped();
+         switch_event_queue_.dropped() + graph_queue_.dropped();
 }
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {
@@ -421,9 +465,11 @@ std::vector<LatencyReport> Pipeline::latency_reports() const {
 }
 
 std::vector<ExecutorReport> Pipeline::executor_reports() const {
-  if (mapping_) return {estimation_exec_.report(), stereo_.report(), vo_.report(), mapping_exec_.report()};
-  if (estimation_) return {estimation_exec_.report(), stereo_.report(), vo_.report()};
-  return {estimation_exec_.report(), stereo_.report()};
+  std::vector<ExecutorReport> out = {estimation_exec_.report(), stereo_.report()};
+  if (estimation_) out.push_back(vo_.report());
+  if (mapping_) out.push_back(mapping_exec_.report());
+  if (graph_) out.push_back(graph_exec_.report());
+  return out;
 }
 
 std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
@@ -436,6 +482,7 @@ std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
     out.push_back(r("dense_stereo", mapping_->match_time()));
     out.push_back(r("mapping", mapping_->map_time()));
   }
+  if (graph_) out.push_back(r("graph_update", graph_->update_time()));
   return out;
 }
 

@@ -15,6 +15,7 @@
 #include "daemon/estimation_stage.h"
 #include "daemon/executor.h"
 #include "daemon/executor_options.h"
+#include "daemon/graph_stage.h"
 #include "daemon/latency_histogram.h"
 #include "daemon/mapping_stage.h"
 #include "daemon/telemetry_stage.h"
@@ -98,6 +99,9 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   // switches. Needs EnableEstimation() first (the setup's frame_switch policy must be off); call
   // before Start().
   Status EnableMapping(const MappingSetup& setup);
+  // Builds and optimizes the robot's SLAM graph from the filter's estimates and frame switches
+  // (graph executor). Needs EnableEstimation() first; call before Start().
+  Status EnableGraph(const GraphStageOptions& options);
   // Asks the filter to switch its frame of reference. One producer: the vo thread (the interim
   // distance/sigma policy) or, with mapping enabled, the mapping thread through the
   // FrameSwitchRequesterInterface below.
@@ -135,6 +139,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   bool mapping_enabled() const { return mapping_ != nullptr; }
   // Valid after StopAndDrain() when mapping is enabled.
   MappingStageReport mapping_report() const;
+  // Valid after StopAndDrain(); null when the graph is not enabled.
+  const GraphStage* graph() const { return graph_.get(); }
   FaultReport fault_report() const;
 
   // Live progress (any thread).
@@ -156,6 +162,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void StereoLoop(std::stop_token stop);
   void VoLoop(std::stop_token stop);
   void MappingLoop(std::stop_token stop);
+  void GraphLoop(std::stop_token stop);
   void DrainEstimates();
   void TakeMappingInputs();
 
@@ -182,6 +189,10 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   SpscQueue<FrameEstimate> mapping_estimate_queue_;
   SpscQueue<FrameSwitchEvent> switch_event_queue_;
   uint64_t mapping_estimates_seen_ = 0;  // estimation thread: when to wake the mapping thread
+  // Graph: estimation -> graph (valid estimates and switches, in one queue to keep their order).
+  WorkSignal graph_signal_;
+  SpscQueue<GraphInput> graph_queue_;
+  uint64_t graph_inputs_seen_ = 0;  // estimation thread: when to wake the graph thread
   const Duration imu_deadline_;
   std::atomic<uint64_t> deadline_misses_{0};
 
@@ -189,6 +200,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   Executor stereo_;
   Executor vo_;
   Executor mapping_exec_;
+  Executor graph_exec_;
 
   // Owned by the estimation thread until joined.
   SensorStreamStats imu_stats_;
@@ -209,6 +221,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   uint64_t rectify_failures_ = 0;
   int pending_dropped_ = 0;
   std::unique_ptr<MappingStage> mapping_;
+  std::unique_ptr<GraphStage> graph_;
   int64_t dense_every_ = 1;
   uint64_t dense_counter_ = 0;  // stereo thread
   uint64_t mapping_switch_requests_ = 0;  // mapping thread

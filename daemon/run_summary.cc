@@ -141,8 +141,25 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("write_failures", m.submap_write_failures).Field("bytes", m.submap_bytes);
     j.EndObject();
     j.Field("map_points", m.map_points).Field("map_voxels", m.map_voxels);
+    j.Field("submaps_placed_by_graph", m.submaps_placed_by_graph);
     j.Key("first_errors").BeginArray();
     for (const auto& e : m.errors) j.String(e);
+    j.EndArray();
+    j.EndObject();
+  }
+  if (const GraphStage* graph = p.graph()) {
+    const GraphStageReport g = graph->report();
+    j.Key("graph").BeginObject();
+    j.Field("estimates", g.estimates);
+    j.Field("inputs_dropped", p.estimation_report().graph_inputs_dropped);
+    j.Field("submap_origins", g.submap_origins).Field("robot_poses", g.robot_poses);
+    j.Field("frame_switches", g.frame_switches).Field("factors", g.factors);
+    j.Field("rejected_factors", g.rejected_factors).Field("unplaced", g.unplaced);
+    j.Field("solves", g.solves).Field("reinitializations", g.reinitializations);
+    j.Field("unconnected_variables", g.unconnected_variables);
+    j.Field("chi2", g.chi2);
+    j.Key("first_errors").BeginArray();
+    for (const auto& e : g.errors) j.String(e);
     j.EndArray();
     j.EndObject();
   }

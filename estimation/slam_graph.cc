@@ -277,6 +277,13 @@ std::vector<uint64_t> SlamGraph::Unconnected() const {
   return out;
 }
 
+std::vector<uint64_t> SlamGraph::VariableKeys() const {
+  std::vector<uint64_t> keys;
+  keys.reserve(variables_.size());
+  for (const auto& [key, v] : variables_) keys.push_back(key);
+  return keys;
+}
+
 double SlamGraph::Chi2() const {
   double chi2 = 0.0;
   for (const auto& f : factors_) {

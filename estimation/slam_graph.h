@@ -140,6 +140,9 @@ class SlamGraph {
   int covariance_computations() const { return covariance_computations_; }
   // Sum over factors of the squared whitened residual (no loss, no 1/2).
   double Chi2() const;
+  // The factors in the graph (not the pending ones), in insertion order, and the variables' keys.
+  const std::vector<SlamFactor>& factors() const { return factors_; }
+  std::vector<uint64_t> VariableKeys() const;
 
  private:
   struct Variable {

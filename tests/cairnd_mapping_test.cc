@@ -17,6 +17,7 @@
 
 #include "drivers/simulator/terrain.h"
 #include "drivers/simulator/world_file.h"
+#include "estimation/g2o_io.h"
 #include "estimation/trajectory.h"
 #include "mapping/map_exporter.h"
 #include "mapping/submap_codec.h"
@@ -137,6 +138,31 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
   EXPECT_LT(err[err.size() / 2], 0.05) << "median height error";
   EXPECT_LT(err[err.size() * 9 / 10], 0.15) << "90th percentile height error";
 
+  // The SLAM graph: one origin per local frame linked by the switches, sparse robot poses; it
+  // places every estimate and every submap. Without loop closures its optimum is the chain of
+  // switches, so the global trajectory is the chained one to rounding.
+  const JsonValue& g = s["graph"];
+  EXPECT_EQ(g["submap_origins"].number(), m["frame_switches"].number() + 1);
+  EXPECT_EQ(g["frame_switches"].number(), m["frame_switches"].number());
+  EXPECT_GT(g["robot_poses"].number(), 0);
+  EXPECT_EQ(g["inputs_dropped"].number(), 0);
+  EXPECT_EQ(g["rejected_factors"].number(), 0);
+  EXPECT_EQ(g["unplaced"].number(), 0);
+  EXPECT_EQ(g["unconnected_variables"].number(), 0);
+  EXPECT_EQ(m["submaps_placed_by_graph"].number(), m["submaps"]["finished"].number());
+  auto global = TrajectoryIo::Read(out + "/a/global_trajectory.tum", TrajectoryFormat::kTum);
+  ASSERT_TRUE(global.ok()) << global.status().ToString();
+  ASSERT_EQ(global->poses.size(), est->poses.size());
+  for (size_t i = 0; i < est->poses.size(); ++i) {
+    EXPECT_EQ(global->poses[i].time, est->poses[i].time);
+    EXPECT_LT((global->poses[i].T_frame_body.translation() - est->poses[i].T_frame_body.translation()).norm(), 1e-5)
+        << i;
+  }
+  PoseGraph graph;
+  ASSERT_TRUE(ParseG2o(ReadBytes(out + "/a/graph.g2o"), "graph.g2o", graph).ok());
+  EXPECT_EQ(graph.num_vertices(), static_cast<size_t>(g["submap_origins"].number() + g["robot_poses"].number()));
+  EXPECT_EQ(graph.edges().size(), static_cast<size_t>(g["frame_switches"].number() + g["robot_poses"].number()));
+
   // The same run again: identical summary and identical submap bytes.
   auto again = RoverArgs(out + "/b", 6.0, 0.5);
   again.insert(again.end(), {"--set", "mapping.partition.max_distance=0.7"});
@@ -148,7 +174,9 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
   for (size_t i = 0; i < files.size(); ++i) {
     EXPECT_EQ(ReadBytes(files[i]), ReadBytes(files_b[i])) << files[i];
   }
-  EXPECT_EQ(ReadBytes(out + "/a/map.ply"), ReadBytes(out + "/b/map.ply"));
+  for (const char* f : {"map.ply", "global_trajectory.tum", "graph.g2o"}) {
+    EXPECT_EQ(ReadBytes(out + "/a/" + f), ReadBytes(out + "/b/" + f)) << f;
+  }
 }
 
 // The FPGA path in the daemon: the board's cycle-accurate simulation (device: sim) behind the

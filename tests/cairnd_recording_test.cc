@@ -261,7 +261,8 @@ TEST(CairndRecordingSimTest, SimulatedRoverRecordingReplaysToTheSameEstimatesAnd
   EXPECT_GT(sa["streams"]["wheel_odometry"]["count"].number(), 500);
   EXPECT_GE(sa["mapping"]["submaps"]["written"].number(), 1);
   EXPECT_EQ(Messages(dir + "/a/recording-000.mcap"), Messages(dir + "/b/recording-000.mcap"));
-  for (const char* f : {"trajectory.tum", "vo.tum", "map.ply", "map.bt", "obstacles.png", "submaps/rover-000000.submap"}) {
+  for (const char* f : {"trajectory.tum", "vo.tum", "global_trajectory.tum", "graph.g2o", "map.ply", "map.bt",
+                        "obstacles.png", "submaps/rover-000000.submap"}) {
     EXPECT_TRUE(FileBytes(dir + "/a/" + f) == FileBytes(dir + "/b/" + f)) << f << " differs";
   }
 }

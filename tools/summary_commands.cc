@@ -82,6 +82,13 @@ int RunSummary(const CommandArgs& args) {
                     m["submaps"]["finished"].number(), m["submaps"]["bytes"].number() / 1024.0,
                     m["map_points"].number());
       }
+      if (s.has("graph")) {
+        const JsonValue& g = s["graph"];
+        std::printf("  graph: %.0f submap origins, %.0f robot poses, %.0f factors (%.0f rejected), %.0f unplaced, "
+                    "chi2 %.3g\n",
+                    g["submap_origins"].number(), g["robot_poses"].number(), g["factors"].number(),
+                    g["rejected_factors"].number(), g["unplaced"].number(), g["chi2"].number());
+      }
       PrintAccuracy(dir);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());
