@@ -267,6 +267,7 @@ int Cairnd::Run() {
     if (telemetry->recording()) run.recording = telemetry->recording_report();
     if (options_.live.enabled) run.live = telemetry->live_report();
     run.telemetry_dropped = telemetry->dropped();
+    run.image_codec_failures = telemetry->image_codec_failures();
     run.extra_executors.push_back(telemetry->executor_report());
   }
   run.complete = finite && run.stop_reason == "end_of_data";

@@ -109,6 +109,12 @@ void FoxgloveServer::OnText(uint64_t client, const std::string& text) {
         }
         subs[sub] = channel;
         ++subscriber_count_[channel];
+        if (const auto l = latched_.find(channel); l != latched_.end()) {
+          for (const auto& [time, payload] : l->second.messages) {
+            server_.SendBinary(client, MessageFrame(sub, time, {reinterpret_cast<const uint8_t*>(payload.data()),
+                                                                payload.size()}));
+          }
+        }
       }
     } else if (op == "unsubscribe") {
       for (const JsonValue& s : msg["subscriptionIds"].array()) {
@@ -134,6 +140,21 @@ bool FoxgloveServer::HasSubscribers(uint32_t channel) const {
   return it != subscriber_count_.end() && it->second > 0;
 }
 
+std::string FoxgloveServer::MessageFrame(uint32_t sub, Timestamp time, std::span<const uint8_t> payload) {
+  std::string frame(1 + 4 + 8 + payload.size(), '\0');
+  frame[0] = 0x01;
+  for (int i = 0; i < 4; ++i) frame[static_cast<size_t>(1 + i)] = static_cast<char>((sub >> (8 * i)) & 0xFF);
+  const auto t = static_cast<uint64_t>(time.nanoseconds());
+  for (int i = 0; i < 8; ++i) frame[static_cast<size_t>(5 + i)] = static_cast<char>((t >> (8 * i)) & 0xFF);
+  std::copy(payload.begin(), payload.end(), frame.begin() + 13);
+  return frame;
+}
+
+void FoxgloveServer::SetLatched(uint32_t channel, size_t depth) {
+  std::lock_guard lock(mutex_);
+  latched_[channel].depth = depth;
+}
+
 void FoxgloveServer::Publish(uint32_t channel, Timestamp time, std::span<const uint8_t> payload) {
   std::vector<std::pair<uint64_t, uint32_t>> targets;
   {
@@ -143,16 +164,12 @@ void FoxgloveServer::Publish(uint32_t channel, Timestamp time, std::span<const u
         if (ch == channel) targets.emplace_back(client, sub);
       }
     }
+    if (const auto l = latched_.find(channel); l != latched_.end() && l->second.depth > 0) {
+      l->second.messages.emplace_back(time, std::string(payload.begin(), payload.end()));
+      while (l->second.messages.size() > l->second.depth) l->second.messages.pop_front();
+    }
   }
-  for (const auto& [client, sub] : targets) {
-    std::string frame(1 + 4 + 8 + payload.size(), '\0');
-    frame[0] = 0x01;
-    for (int i = 0; i < 4; ++i) frame[static_cast<size_t>(1 + i)] = static_cast<char>((sub >> (8 * i)) & 0xFF);
-    const auto t = static_cast<uint64_t>(time.nanoseconds());
-    for (int i = 0; i < 8; ++i) frame[static_cast<size_t>(5 + i)] = static_cast<char>((t >> (8 * i)) & 0xFF);
-    std::copy(payload.begin(), payload.end(), frame.begin() + 13);
-    server_.SendBinary(client, std::move(frame));
-  }
+  for (const auto& [client, sub] : targets) server_.SendBinary(client, MessageFrame(sub, time, payload));
 }
 
 uint64_t FoxgloveServer::protocol_errors() const {

@@ -4,6 +4,7 @@
 // safe from any thread and never blocks on the network.
 
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <set>
@@ -33,6 +34,9 @@ class FoxgloveServer {
 
   // Channels must be added before Start().
   uint32_t AddChannel(FoxgloveChannel channel);
+  // The channel keeps its last `depth` messages and sends them to each new subscriber first (a
+  // viewer that connects late still sees the latest graph, the recent log lines).
+  void SetLatched(uint32_t channel, size_t depth);
   Status Start(const std::string& address, uint16_t port, size_t client_queue);
   void Stop();
   uint16_t port() const { return server_.port(); }
@@ -53,6 +57,7 @@ class FoxgloveServer {
   void OnClose(uint64_t client);
   void OnText(uint64_t client, const std::string& text);
   void SendStatus(uint64_t client, int level, const std::string& message);
+  static std::string MessageFrame(uint32_t subscription, Timestamp time, std::span<const uint8_t> payload);
 
   std::string name_;
   std::vector<FoxgloveChannel> channels_;
@@ -61,6 +66,11 @@ class FoxgloveServer {
   // client -> subscription id -> channel
   std::map<uint64_t, std::map<uint32_t, uint32_t>> subscriptions_;
   std::map<uint32_t, size_t> subscriber_count_;  // channel -> subscriptions
+  struct Latched {
+    size_t depth = 0;
+    std::deque<std::pair<Timestamp, std::string>> messages;
+  };
+  std::map<uint32_t, Latched> latched_;  // channel -> its last messages
   uint64_t protocol_errors_ = 0;
   bool started_ = false;
 };

@@ -97,6 +97,7 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
     return;
   }
   estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
+  last_time_ = e.time;
   if (valid_seen_++ % static_cast<uint64_t>(options_.pose_every) != 0) return;
   SlamFactor v;
   v.kind = FactorKind::kFilterEstimate;
@@ -164,6 +165,36 @@ Trajectory GraphStage::GlobalTrajectory() const {
     t.poses.push_back(StampedPose{e.time, origin->second * e.T_frame_body});
   }
   return t;
+}
+
+GraphScene GraphStage::Scene(bool covariances) {
+  GraphScene scene;
+  std::vector<uint64_t> origin_keys;
+  for (uint64_t key : graph_.VariableKeys()) {
+    auto p = graph_.Pose(key);
+    if (!p.ok()) continue;
+    GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero()};
+    if (KindOfKey(key) == VariableKind::kSubmap) {
+      scene.origins.push_back(node);
+      origin_keys.push_back(key);
+    } else {
+      scene.poses.push_back(node);
+    }
+  }
+  if (covariances && !origin_keys.empty()) {
+    auto cov = graph_.Covariances(origin_keys);
+    if (cov.ok()) {
+      for (size_t i = 0; i < scene.origins.size(); ++i) {
+        scene.origins[i].position_covariance = (*cov)[i].topLeftCorner<3, 3>();
+      }
+    } else {
+      Error("covariances for the live view: " + cov.status().ToString());
+    }
+  }
+  for (const SlamFactor& f : graph_.factors()) {
+    if (!IsUnary(f.kind)) scene.edges.push_back(GraphScene::Edge{f.a, f.b, f.kind});
+  }
+  return scene;
 }
 
 PoseGraph GraphStage::ExportPoseGraph() const {

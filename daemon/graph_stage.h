@@ -41,6 +41,22 @@ struct GraphStageReport {
   std::vector<std::string> errors;  // the first few, verbatim
 };
 
+// What the live view draws of the graph: its variables at their current estimates and its factors.
+struct GraphScene {
+  struct Node {
+    uint64_t key = 0;
+    Eigen::Isometry3d T_global = Eigen::Isometry3d::Identity();
+    // Submap origins: marginal position covariance (m^2, global frame); zero when not computed.
+    Eigen::Matrix3d position_covariance = Eigen::Matrix3d::Zero();
+  };
+  struct Edge {
+    uint64_t from = 0, to = 0;
+    FactorKind kind = FactorKind::kFrameSwitch;
+  };
+  std::vector<Node> origins, poses;
+  std::vector<Edge> edges;
+};
+
 class GraphStage {
  public:
   GraphStage(const GraphStageOptions& options, bool deterministic);
@@ -50,6 +66,10 @@ class GraphStage {
   void Finish();
 
   GraphStageReport report() const;
+  char robot() const { return robot_; }
+  // Time of the last estimate placed, and the number of submap origins (cheap, for live updates).
+  Timestamp last_time() const { return last_time_; }
+  uint64_t submap_origins() const { return report_.submap_origins; }
   const LatencyHistogram& update_time() const { return update_time_; }
   // T_global_frame of every local frame in the graph (global = the first frame).
   std::map<uint64_t, Eigen::Isometry3d> FrameOrigins() const;
@@ -58,6 +78,9 @@ class GraphStage {
   // The graph's variables (optimized) and binary factors, for g2o export. Keys carry the robot
   // letter in the top byte and the kind ('s' origin, 'x' pose) in the next.
   PoseGraph ExportPoseGraph() const;
+  // The graph now; with `covariances` the origins' marginal covariances too (cached by the graph
+  // until it changes significantly).
+  GraphScene Scene(bool covariances);
 
  private:
   void OnEstimate(const FrameEstimate& e);
@@ -80,6 +103,7 @@ class GraphStage {
     Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
   };
   std::vector<Placed> estimates_;
+  Timestamp last_time_;
   LatencyHistogram update_time_;
   GraphStageReport report_;
 };

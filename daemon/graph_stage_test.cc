@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include "daemon/graph_scene_encoder.h"
 #include "estimation/g2o_io.h"
+#include "foxglove/SceneUpdate.pb.h"
 
 namespace cairn {
 namespace {
@@ -155,6 +157,54 @@ TEST(GraphStageTest, BadCovarianceIsRejectedAndTheGraphGoesOn) {
   EXPECT_EQ(r.rejected_factors, 1u);
   EXPECT_EQ(r.robot_poses, 5u);
   EXPECT_EQ(g.GlobalTrajectory().poses.size(), 30u);
+}
+
+TEST(GraphSceneEncoderTest, OriginsAreTwoSigmaEllipsoidsAndFactorsAreLines) {
+  GraphScene scene;
+  GraphScene::Node s0{VariableKey(VariableKind::kSubmap, 'a', 0), Eigen::Isometry3d::Identity(), Eigen::Matrix3d::Zero()};
+  GraphScene::Node s1{VariableKey(VariableKind::kSubmap, 'a', 1), Pose(2.0, 0.0, 0.0), Eigen::Matrix3d::Zero()};
+  s1.position_covariance.diagonal() << 0.04, 0.01, 0.0;  // sigmas 0.2, 0.1, 0 m
+  GraphScene::Node x0{VariableKey(VariableKind::kRobotPose, 'a', 0), Pose(1.0, 0.5, 0.3), Eigen::Matrix3d::Zero()};
+  scene.origins = {s0, s1};
+  scene.poses = {x0};
+  scene.edges = {{s0.key, s1.key, FactorKind::kFrameSwitch}, {s0.key, x0.key, FactorKind::kFilterEstimate}};
+  GraphSceneEncoder encoder;
+  foxglove::SceneUpdate u;
+  ASSERT_TRUE(u.ParseFromString(encoder.Encode(Timestamp::FromNanoseconds(1500000000), 'a', scene)));
+  ASSERT_EQ(u.entities_size(), 1);
+  const foxglove::SceneEntity& e = u.entities(0);
+  EXPECT_EQ(e.id(), "graph/a");
+  EXPECT_EQ(e.frame_id(), "map");
+  EXPECT_EQ(e.timestamp().seconds(), 1);
+  EXPECT_EQ(e.timestamp().nanos(), 500000000);
+  ASSERT_EQ(e.spheres_size(), 3);
+  // s1: diameters of 4 sigma along the eigenvectors (any order), the unknown axis at the minimum.
+  std::vector<double> d = {e.spheres(1).size().x(), e.spheres(1).size().y(), e.spheres(1).size().z()};
+  std::sort(d.begin(), d.end());
+  EXPECT_NEAR(d[0], 0.05, 1e-12);
+  EXPECT_NEAR(d[1], 0.4, 1e-12);
+  EXPECT_NEAR(d[2], 0.8, 1e-12);
+  EXPECT_NEAR(e.spheres(1).pose().position().x(), 2.0, 1e-12);
+  ASSERT_EQ(e.lines_size(), 2);
+  EXPECT_EQ(e.lines(0).type(), foxglove::LinePrimitive::LINE_LIST);
+  EXPECT_EQ(e.lines(0).points_size(), 2);  // the frame switch
+  EXPECT_EQ(e.lines(1).points_size(), 2);  // the pose factor
+  EXPECT_NEAR(e.lines(1).points(1).y(), 0.5, 1e-12);
+  ASSERT_EQ(e.texts_size(), 2);
+  EXPECT_EQ(e.texts(1).text(), "s1");
+}
+
+TEST(GraphStageTest, SceneShowsEveryVariableAndBinaryFactor) {
+  const Drive d = MakeDrive(60, 20);
+  GraphStage g(Options(), true);
+  for (const GraphInput& in : d.inputs) g.OnInput(in);
+  const GraphScene scene = g.Scene(/*covariances=*/true);
+  EXPECT_EQ(scene.origins.size(), 3u);
+  EXPECT_EQ(scene.poses.size(), 12u);
+  EXPECT_EQ(scene.edges.size(), 2u + 12u);
+  // The first origin holds the prior: known to its floor; later ones less well.
+  EXPECT_LT(scene.origins[0].position_covariance.trace(), scene.origins[2].position_covariance.trace());
+  EXPECT_GT(scene.origins[2].position_covariance.trace(), 0.0);
 }
 
 }  // namespace

@@ -422,6 +422,15 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       graph_queue_.PopFront();
       worked = true;
     }
+    // The live view: at each new origin, else about once a second of data.
+    if (worked && telemetry_ != nullptr && telemetry_->live() &&
+        (graph_->submap_origins() != graph_shown_origins_ ||
+         graph_->last_time() - graph_shown_time_ >= Duration::Seconds(1.0))) {
+      graph_shown_origins_ = graph_->submap_origins();
+      graph_shown_time_ = graph_->last_time();
+      telemetry_->PublishGraph(graph_shown_time_,
+                               graph_scene_.Encode(graph_shown_time_, graph_->robot(), graph_->Scene(true)));
+    }
     // The estimation thread has stopped before this is asked: its last inputs are in the queue.
     if (stop.stop_requested() && graph_queue_.empty()) return;
     if (!worked) graph_signal_.WaitChange(seen);

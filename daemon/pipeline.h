@@ -15,6 +15,7 @@
 #include "daemon/estimation_stage.h"
 #include "daemon/executor.h"
 #include "daemon/executor_options.h"
+#include "daemon/graph_scene_encoder.h"
 #include "daemon/graph_stage.h"
 #include "daemon/latency_histogram.h"
 #include "daemon/mapping_stage.h"
@@ -222,6 +223,9 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   int pending_dropped_ = 0;
   std::unique_ptr<MappingStage> mapping_;
   std::unique_ptr<GraphStage> graph_;
+  GraphSceneEncoder graph_scene_;       // graph thread: the live /graph view
+  uint64_t graph_shown_origins_ = 0;
+  Timestamp graph_shown_time_;
   int64_t dense_every_ = 1;
   uint64_t dense_counter_ = 0;  // stereo thread
   uint64_t mapping_switch_requests_ = 0;  // mapping thread

@@ -71,6 +71,7 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("bytes", run.recording->bytes);
     j.Field("dropped", run.telemetry_dropped);
     j.Field("write_errors", run.recording->write_errors);
+    j.Field("image_codec_failures", run.image_codec_failures);
     j.EndObject();
   }
   if (p.estimation_enabled()) {
@@ -207,6 +208,7 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
     j.Field("port", run.live->port).Field("published", run.live->published);
     j.Field("dropped_for_slow_clients", run.live->dropped).Field("protocol_errors", run.live->protocol_errors);
     j.Field("server_cpu_seconds", run.live->server_cpu_seconds);
+    j.Field("image_codec_failures", run.image_codec_failures);
     j.EndObject();
   }
   j.Field("deadline_misses", p.deadline_misses());

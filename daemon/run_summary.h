@@ -30,6 +30,7 @@ struct RunInfo {
   std::optional<RecordingReport> recording;
   std::optional<LiveStreamReport> live;
   uint64_t telemetry_dropped = 0;
+  uint64_t image_codec_failures = 0;  // images the PNG/JPEG encoder refused (recording or live)
   std::vector<ExecutorReport> extra_executors;  // executors outside the pipeline (telemetry)
   double wall_time = 0.0;   // s
   bool memory_locked = false;

@@ -6,7 +6,10 @@
 #include <limits>
 
 #include "daemon/json_writer.h"
+#include "daemon/live_log_sink.h"
 #include "daemon/protobuf_schema.h"
+#include "foxglove/Log.pb.h"
+#include "foxglove/SceneUpdate.pb.h"
 #include "hal/monotonic_clock.h"
 
 namespace cairn {
@@ -20,7 +23,10 @@ TelemetryStage::TelemetryStage(const ExecutorOptions& executor, size_t queue_dep
       maps_(16),  // a few submaps and grids a minute; each holds its data by reference
       executor_("telemetry", executor) {}
 
-TelemetryStage::~TelemetryStage() { StopAndDrain(); }
+TelemetryStage::~TelemetryStage() {
+  StopAndDrain();
+  DetachLog();  // also when the stage never started
+}
 
 void TelemetryStage::EnableRecording(std::string directory, const RecordingOptions& options, std::string calibration) {
   recorder_ = std::make_unique<McapRecorder>(std::move(directory), options);
@@ -42,11 +48,30 @@ Status TelemetryStage::EnableLiveStream(const std::string& robot_name, const Liv
       0, "/diagnostics", "json", "cairn.Diagnostics",
       R"({"type":"object","properties":{"status":{"type":"string"},"time_ns":{"type":"integer"}}})",
       "jsonschema"});
+  const auto add = [this](const char* topic, const google::protobuf::Descriptor* d) {
+    const std::string set = ProtobufFileDescriptorSet(d);
+    return live_->AddChannel(FoxgloveChannel{0, topic, "protobuf", d->full_name(),
+                                             FoxgloveServer::Base64({reinterpret_cast<const uint8_t*>(set.data()), set.size()}),
+                                             "protobuf"});
+  };
+  graph_channel_ = add("/graph", foxglove::SceneUpdate::descriptor());
+  log_channel_ = add("/log", foxglove::Log::descriptor());
+  live_->SetLatched(graph_channel_, 1);
+  live_->SetLatched(log_channel_, 200);
   image_every_ = options.image_every;
   live_images_ = options.images;
   const Status s = live_->Start(options.address, static_cast<uint16_t>(options.port),
                                 static_cast<size_t>(options.client_queue));
-  if (!s.ok()) live_.reset();
+  if (!s.ok()) {
+    live_.reset();
+    return s;
+  }
+  // Only the main thread runs yet (stages and sources start later), so the logger's sink list may
+  // change here; StopAndDrain() detaches it again once they have stopped.
+  log_sink_ = std::make_shared<LiveLogSink>("cairnd " + robot_name, [this](Timestamp t, std::span<const uint8_t> b) {
+    live_->Publish(log_channel_, t, b);
+  });
+  spdlog::default_logger_raw()->sinks().push_back(log_sink_);
   return s;
 }
 
@@ -65,7 +90,20 @@ void TelemetryStage::StopAndDrain() {
   if (recorder_) {
     if (Status s = recorder_->Close(); !s.ok()) spdlog::error("recording: {}", s.ToString());
   }
+  DetachLog();
   if (live_) live_->Stop();
+}
+
+void TelemetryStage::DetachLog() {
+  if (!log_sink_) return;
+  log_sink_->Detach();
+  auto& sinks = spdlog::default_logger_raw()->sinks();
+  sinks.erase(std::remove(sinks.begin(), sinks.end(), log_sink_), sinks.end());
+  log_sink_.reset();
+}
+
+void TelemetryStage::PublishGraph(Timestamp time, const std::string& encoded) {
+  if (live_) live_->Publish(graph_channel_, time, {reinterpret_cast<const uint8_t*>(encoded.data()), encoded.size()});
 }
 
 LiveStreamReport TelemetryStage::live_report() const {

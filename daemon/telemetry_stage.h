@@ -54,10 +54,17 @@ class TelemetryStage {
                          double z);
   // The daemon's periodic status line, to the live /diagnostics channel (any thread).
   void PublishDiagnostics(const std::string& status);
+  // Live-only channels: /graph (foxglove.SceneUpdate, the latest one kept for late viewers) and
+  // /log (foxglove.Log, every log line from the stream's start, the last 200 kept). Recordings
+  // leave them out: a replay of a recording rebuilds the graph, and log lines carry wall time.
+  bool live() const { return live_ != nullptr; }
+  void PublishGraph(Timestamp time, const std::string& encoded);
 
   bool recording() const { return recorder_ != nullptr; }
   const RecordingReport& recording_report() const { return recorder_->report(); }
   LiveStreamReport live_report() const;
+  // Images the PNG/JPEG encoder refused (not recorded or streamed); valid after StopAndDrain().
+  uint64_t image_codec_failures() const { return image_codec_failures_; }
   uint64_t dropped() const {
     return imu_.dropped() + wheel_.dropped() + stereo_.dropped() + poses_.dropped() + maps_.dropped();
   }
@@ -83,6 +90,7 @@ class TelemetryStage {
   template <class T>
   void Offer(SpscQueue<Item<T>>& queue, const T& value);
   void HandleMap(const MapItem& m);
+  void DetachLog();
   bool Wanted(TelemetryTopic topic) const;
   void Loop(std::stop_token stop);
   void Emit(TelemetryTopic topic, Timestamp time, const std::string& encoded);
@@ -106,6 +114,9 @@ class TelemetryStage {
   std::unique_ptr<FoxgloveServer> live_;
   uint32_t live_channel_[kTelemetryTopicCount] = {};
   uint32_t diagnostics_channel_ = 0;
+  uint32_t graph_channel_ = 0;
+  uint32_t log_channel_ = 0;
+  std::shared_ptr<class LiveLogSink> log_sink_;
   int64_t image_every_ = 1;
   ImageEncodingOptions recording_images_;
   ImageEncodingOptions live_images_;

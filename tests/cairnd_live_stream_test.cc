@@ -105,6 +105,28 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   EXPECT_EQ(r["channels"]["/tf"]["schema"].string(), "foxglove.FrameTransform");
   EXPECT_EQ(r["channels"]["/map/submaps"]["schema"].string(), "foxglove.PointCloud");
   EXPECT_EQ(r["channels"]["/map/obstacles"]["schema"].string(), "foxglove.Grid");
+  // Live-only views: the SLAM graph (foxglove.SceneUpdate) and the daemon's log (foxglove.Log),
+  // whose recent lines a late subscriber receives too, so the start-up line is there.
+  const testing::JsonValue& graph = r["channels"]["/graph"];
+  EXPECT_EQ(graph["schema"].string(), "foxglove.SceneUpdate");
+  EXPECT_GT(graph["count"].number(), 0);
+  EXPECT_EQ(graph["decodeErrors"].number(), 0);
+  EXPECT_EQ(graph["lastGraph"]["entities"].number(), 1);
+  EXPECT_EQ(graph["lastGraph"]["id"].string(), "graph/a");
+  EXPECT_EQ(graph["lastGraph"]["frame"].string(), "map");
+  EXPECT_GE(graph["lastGraph"]["spheres"].number(), 2);  // the first origin and a robot pose at least
+  EXPECT_EQ(graph["lastGraph"]["lines"].number(), 2);
+  EXPECT_GE(graph["lastGraph"]["texts"].number(), 1);
+  const testing::JsonValue& log = r["channels"]["/log"];
+  EXPECT_EQ(log["schema"].string(), "foxglove.Log");
+  EXPECT_EQ(log["decodeErrors"].number(), 0);
+  bool startup_line = false;
+  ASSERT_TRUE(log.has("lines")) << client.output;
+  for (const testing::JsonValue& line : log["lines"].array()) {
+    startup_line = startup_line || line["message"].string().find("live stream (Foxglove WebSocket) on") != std::string::npos;
+    EXPECT_EQ(line["name"].string(), "cairnd euroc-mav");
+  }
+  EXPECT_TRUE(startup_line) << client.output;
   const testing::JsonValue d = testing::JsonValue::ParseFile(out + "/diagnostics.json");
   EXPECT_EQ(d["live_stream"]["port"].number(), port);
   EXPECT_GT(d["live_stream"]["published"].number(), 400);

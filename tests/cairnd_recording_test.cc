@@ -114,6 +114,7 @@ TEST_F(CairndRecordingTest, ReplayOfARecordingReproducesTheRunAndTheRecording) {
   EXPECT_EQ(rec["messages"]["/stereo/info"].number(), 95);
   EXPECT_EQ(rec["dropped"].number(), 0);
   EXPECT_EQ(rec["write_errors"].number(), 0);
+  EXPECT_EQ(rec["image_codec_failures"].number(), 0);
   EXPECT_EQ(rec["bytes"].number(), static_cast<double>(fs::file_size(dir_ + "/a/recording-000.mcap")));
 
   const auto second = RunCairnd(dir_ + "/a/recording-000.mcap", dir_ + "/b");

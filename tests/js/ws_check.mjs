@@ -82,6 +82,12 @@ client.on("message", ({ subscriptionId, data }) => {
     if (t !== null) r.last = t.toString();
     if (s.ch.topic.endsWith("/image")) r.lastImage = { width: m.width, height: m.height, bytes: m.data.length, encoding: m.encoding };
     if (s.ch.topic.endsWith("/image/compressed")) r.lastImage = { format: m.format, bytes: m.data.length, ...jpegSize(m.data) };
+    if (s.ch.topic === "/graph") {
+      const e = m.entities[0] ?? { spheres: [], lines: [], texts: [] };
+      r.lastGraph = { entities: m.entities.length, id: e.id, frame: e.frameId ?? e.frame_id, spheres: e.spheres.length,
+                      lines: e.lines.length, texts: e.texts.length };
+    }
+    if (s.ch.topic === "/log") (r.lines ??= []).push({ level: m.level, message: m.message, name: m.name });
     r.count++;
   } catch (e) {
     r.decodeErrors++;
