@@ -2,6 +2,7 @@
 // daemon as a user runs it (`cairnd --config configs/rover.yaml --sim`), and the errors a wrong
 // simulation setup gives before anything runs.
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -85,6 +86,37 @@ TEST(CairndSimTest, WrongSetupsAreRefusedNamingTheKey) {
   r = RunProcess({Cairnd(), "--config", Config("rover"), "--sim", "--replay", "/tmp"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("exclude each other"), std::string::npos) << r.output;
+}
+
+// Trajectory exports in every format parse back to the same poses, for the filter's chained
+// trajectory and the SLAM graph's global one; a format nobody knows is refused at start-up.
+TEST(CairndSimTest, TrajectoriesInEveryFormatReadBack) {
+  const std::string out = testing::FreshTempDir("cairnd_sim_formats");
+  auto args = SimArgs("rover", out);
+  args.insert(args.end(), {"--set", "sim.duration=4", "--set", "sim.image_scale=0.5", "--set", "mapping.enabled=false",
+                           "--set", "stereo.enabled=false", "--set", "output.trajectory_formats=tum, euroc,kitti"});
+  const auto r = RunProcess(args);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const std::string stem : {"trajectory", "global_trajectory"}) {
+    auto tum = TrajectoryIo::Read(out + "/" + stem + ".tum", TrajectoryFormat::kTum);
+    auto csv = TrajectoryIo::Read(out + "/" + stem + ".csv", TrajectoryFormat::kEurocCsv);
+    auto kitti = TrajectoryIo::Read(out + "/" + stem + ".kitti", TrajectoryFormat::kKitti, out + "/" + stem + "_times.txt");
+    ASSERT_TRUE(tum.ok() && csv.ok() && kitti.ok()) << stem;
+    ASSERT_GT(tum->poses.size(), 5u) << stem;
+    ASSERT_EQ(csv->poses.size(), tum->poses.size()) << stem;
+    ASSERT_EQ(kitti->poses.size(), tum->poses.size()) << stem;
+    for (size_t i = 0; i < tum->poses.size(); ++i) {
+      EXPECT_EQ(csv->poses[i].time, tum->poses[i].time);
+      EXPECT_LT(std::abs((kitti->poses[i].time - tum->poses[i].time).seconds()), 1e-6);
+      EXPECT_LT((csv->poses[i].T_frame_body.matrix() - tum->poses[i].T_frame_body.matrix()).norm(), 1e-6) << i;
+      EXPECT_LT((kitti->poses[i].T_frame_body.matrix() - tum->poses[i].T_frame_body.matrix()).norm(), 1e-6) << i;
+    }
+  }
+  auto bad = SimArgs("rover", out + "/bad");
+  bad.insert(bad.end(), {"--set", "output.trajectory_formats=tum,bag"});
+  const auto rb = RunProcess(bad);
+  EXPECT_EQ(rb.exit_code, 1) << rb.output;
+  EXPECT_NE(rb.output.find("trajectory_formats"), std::string::npos) << rb.output;
 }
 
 }  // namespace
