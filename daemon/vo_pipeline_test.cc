@@ -101,6 +101,7 @@ TEST(VoPipelineTest, BadAndDroppedFramesAreReportedAndTheFilterKeepsRunning) {
   EXPECT_TRUE(saw_blank);
 }
 
+// Also the graph thread and the live stream (its /graph view and the log sink) beside them.
 TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   const RectifiedStereoCamera cam = testing::VoTestScene::EurocLikeCamera();
   EstimationSetup setup = RoomSetup(cam);
@@ -119,6 +120,17 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   Pipeline p(ex, queues, PipelineRates{200.0, 20.0, 0.0}, /*deterministic=*/false);
   ASSERT_TRUE(p.EnableEstimation(setup).ok());
   ASSERT_TRUE(p.EnableMapping(mapping).ok());
+  GraphStageOptions graph;
+  graph.enabled = true;
+  graph.pose_every = 2;
+  ASSERT_TRUE(p.EnableGraph(graph).ok());
+  TelemetryStage telemetry(ExecutorOptions{}, 64, /*deterministic=*/false);
+  LiveStreamOptions live;
+  live.enabled = true;
+  live.port = 0;
+  ASSERT_TRUE(telemetry.EnableLiveStream("test", live).ok());
+  telemetry.Start();
+  p.SetTelemetry(&telemetry);
   p.Start();
   const testing::VoTestScene scene(cam, 5);
   const testing::RenderedPair view = scene.Render(Eigen::Isometry3d::Identity());
@@ -154,7 +166,17 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
     if (k >= 600 && dense_taken() >= taken_at_start + 4) break;
   }
   p.StopAndDrain();
+  telemetry.StopAndDrain();
   const MappingStageReport m = p.mapping_report();
+  ASSERT_NE(p.graph(), nullptr);
+  const GraphStageReport g = p.graph()->report();
+  EXPECT_GT(g.estimates, 0u);
+  EXPECT_GT(g.robot_poses, 0u);
+  EXPECT_EQ(g.rejected_factors, 0u);
+  EXPECT_EQ(g.unplaced, 0u);
+  EXPECT_EQ(g.frame_switches, p.estimation_report().frame_switches);
+  EXPECT_EQ(m.submaps_placed_by_graph, m.submaps_finished);
+  EXPECT_EQ(p.graph()->GlobalTrajectory().poses.size(), g.estimates);
   EXPECT_GT(m.pairs, 0u);
   EXPECT_EQ(m.match_failures, 0u);
   EXPECT_EQ(m.mapping_errors, 0u);
