@@ -184,12 +184,13 @@ GraphScene GraphStage::Scene(bool covariances) {
   if (covariances && !origin_keys.empty()) {
     auto cov = graph_.Covariances(origin_keys);
     if (cov.ok()) {
-      for (size_t i = 0; i < scene.origins.size(); ++i) {
-        scene.origins[i].position_covariance = (*cov)[i].topLeftCorner<3, 3>();
-      }
+      for (size_t i = 0; i < origin_keys.size(); ++i) origin_covariance_[origin_keys[i]] = (*cov)[i].topLeftCorner<3, 3>();
     } else {
       Error("covariances for the live view: " + cov.status().ToString());
     }
+  }
+  for (GraphScene::Node& n : scene.origins) {
+    if (const auto c = origin_covariance_.find(n.key); c != origin_covariance_.end()) n.position_covariance = c->second;
   }
   for (const SlamFactor& f : graph_.factors()) {
     if (!IsUnary(f.kind)) scene.edges.push_back(GraphScene::Edge{f.a, f.b, f.kind});

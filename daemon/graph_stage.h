@@ -78,8 +78,9 @@ class GraphStage {
   // The graph's variables (optimized) and binary factors, for g2o export. Keys carry the robot
   // letter in the top byte and the kind ('s' origin, 'x' pose) in the next.
   PoseGraph ExportPoseGraph() const;
-  // The graph now; with `covariances` the origins' marginal covariances too (cached by the graph
-  // until it changes significantly).
+  // The graph now, with the origins' marginal covariances as last computed; `covariances`
+  // computes them again (a Ceres covariance solve over the graph: the live view asks at each new
+  // origin, not at every pose).
   GraphScene Scene(bool covariances);
 
  private:
@@ -104,6 +105,7 @@ class GraphStage {
   };
   std::vector<Placed> estimates_;
   Timestamp last_time_;
+  std::map<uint64_t, Eigen::Matrix3d> origin_covariance_;  // of the live view, as last computed
   LatencyHistogram update_time_;
   GraphStageReport report_;
 };

@@ -423,13 +423,13 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       worked = true;
     }
     // The live view: at each new origin, else about once a second of data.
+    const bool new_origin = graph_->submap_origins() != graph_shown_origins_;
     if (worked && telemetry_ != nullptr && telemetry_->live() &&
-        (graph_->submap_origins() != graph_shown_origins_ ||
-         graph_->last_time() - graph_shown_time_ >= Duration::Seconds(1.0))) {
+        (new_origin || graph_->last_time() - graph_shown_time_ >= Duration::Seconds(1.0))) {
       graph_shown_origins_ = graph_->submap_origins();
       graph_shown_time_ = graph_->last_time();
       telemetry_->PublishGraph(graph_shown_time_,
-                               graph_scene_.Encode(graph_shown_time_, graph_->robot(), graph_->Scene(true)));
+                               graph_scene_.Encode(graph_shown_time_, graph_->robot(), graph_->Scene(new_origin)));
     }
     // The estimation thread has stopped before this is asked: its last inputs are in the queue.
     if (stop.stop_requested() && graph_queue_.empty()) return;
