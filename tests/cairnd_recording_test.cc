@@ -249,7 +249,8 @@ TEST(CairndRecordingSimTest, SimulatedRoverRecordingReplaysToTheSameEstimatesAnd
   const std::vector<std::string> common = {"--set", "replay.pacing=fast", "--set", "replay.deterministic=true",
                                            "--set", "recording.enabled=true", "--set", "recording.images.format=png",
                                            "--set", "live.enabled=false"};
-  std::vector<std::string> sim = {Cairnd(), "--config", config, "--sim", "--out", dir + "/a", "--set", "sim.duration=6"};
+  std::vector<std::string> sim = {Cairnd(), "--config", config, "--sim", "--out", dir + "/a", "--set", "sim.duration=6",
+                              "--set", "sim.image_scale=0.5"};
   sim.insert(sim.end(), common.begin(), common.end());
   const auto a = testing::RunProcess(sim);
   ASSERT_EQ(a.exit_code, 0) << a.output;
