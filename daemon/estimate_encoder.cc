@@ -2,6 +2,7 @@
 
 #include <cstring>
 
+#include "daemon/foxglove_fields.h"
 #include "foxglove/FrameTransform.pb.h"
 #include "foxglove/Grid.pb.h"
 #include "foxglove/PointCloud.pb.h"
@@ -9,22 +10,6 @@
 
 namespace cairn {
 namespace {
-
-void SetTime(Timestamp t, google::protobuf::Timestamp* out) {
-  out->set_seconds(t.nanoseconds() / 1000000000);
-  out->set_nanos(static_cast<int32_t>(t.nanoseconds() % 1000000000));
-}
-
-void SetPose(const Eigen::Isometry3d& T, foxglove::Pose* out) {
-  const Eigen::Quaterniond q(T.linear());
-  out->mutable_position()->set_x(T.translation().x());
-  out->mutable_position()->set_y(T.translation().y());
-  out->mutable_position()->set_z(T.translation().z());
-  out->mutable_orientation()->set_x(q.x());
-  out->mutable_orientation()->set_y(q.y());
-  out->mutable_orientation()->set_z(q.z());
-  out->mutable_orientation()->set_w(q.w());
-}
 
 void AddField(const char* name, uint32_t offset, foxglove::NumericType type,
               google::protobuf::RepeatedPtrField<foxglove::PackedElementField>* fields) {
@@ -38,16 +23,16 @@ void AddField(const char* name, uint32_t offset, foxglove::NumericType type,
 
 const std::string& EstimateEncoder::Pose(Timestamp time, const Eigen::Isometry3d& T_map_body) {
   foxglove::PoseInFrame m;
-  SetTime(time, m.mutable_timestamp());
+  SetFoxgloveTime(time, m.mutable_timestamp());
   m.set_frame_id(kMapFrame);
-  SetPose(T_map_body, m.mutable_pose());
+  SetFoxglovePose(T_map_body, m.mutable_pose());
   m.SerializeToString(&pose_);
   return pose_;
 }
 
 const std::string& EstimateEncoder::Transform(Timestamp time, const Eigen::Isometry3d& T_map_body) {
   foxglove::FrameTransform m;
-  SetTime(time, m.mutable_timestamp());
+  SetFoxgloveTime(time, m.mutable_timestamp());
   m.set_parent_frame_id(kMapFrame);
   m.set_child_frame_id(kBodyFrame);
   const Eigen::Quaterniond q(T_map_body.linear());
@@ -66,9 +51,9 @@ const std::string& EstimateEncoder::Cloud(Timestamp time, const Eigen::Isometry3
                                           const std::vector<CloudPoint>& points) {
   constexpr uint32_t kStride = 16;  // x y z float32, intensity, obstacle, 2 bytes padding
   foxglove::PointCloud m;
-  SetTime(time, m.mutable_timestamp());
+  SetFoxgloveTime(time, m.mutable_timestamp());
   m.set_frame_id(kMapFrame);
-  SetPose(T_map_submap, m.mutable_pose());
+  SetFoxglovePose(T_map_submap, m.mutable_pose());
   m.set_point_stride(kStride);
   AddField("x", 0, foxglove::FLOAT32, m.mutable_fields());
   AddField("y", 4, foxglove::FLOAT32, m.mutable_fields());
@@ -90,10 +75,10 @@ const std::string& EstimateEncoder::Cloud(Timestamp time, const Eigen::Isometry3
 const std::string& EstimateEncoder::Grid(Timestamp time, const Eigen::Isometry3d& T_map_local, double z,
                                          const GridMap& grid) {
   foxglove::Grid m;
-  SetTime(time, m.mutable_timestamp());
+  SetFoxgloveTime(time, m.mutable_timestamp());
   m.set_frame_id(kMapFrame);
   // The local frame is gravity aligned, so the grid lies flat in it; cell (0, 0) is its corner.
-  SetPose(T_map_local * Eigen::Translation3d(grid.origin_x, grid.origin_y, z), m.mutable_pose());
+  SetFoxglovePose(T_map_local * Eigen::Translation3d(grid.origin_x, grid.origin_y, z), m.mutable_pose());
   m.set_column_count(static_cast<uint32_t>(grid.width));
   m.mutable_cell_size()->set_x(grid.resolution);
   m.mutable_cell_size()->set_y(grid.resolution);

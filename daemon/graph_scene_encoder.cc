@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "daemon/estimate_encoder.h"
+#include "daemon/foxglove_fields.h"
 #include "foxglove/SceneUpdate.pb.h"
 
 namespace cairn {
@@ -13,17 +14,6 @@ namespace {
 
 constexpr double kMinOriginDiameter = 0.05;  // m
 constexpr double kPoseDiameter = 0.03;       // m
-
-void SetPose(const Eigen::Isometry3d& T, foxglove::Pose* p) {
-  const Eigen::Quaterniond q(T.rotation());
-  p->mutable_position()->set_x(T.translation().x());
-  p->mutable_position()->set_y(T.translation().y());
-  p->mutable_position()->set_z(T.translation().z());
-  p->mutable_orientation()->set_x(q.x());
-  p->mutable_orientation()->set_y(q.y());
-  p->mutable_orientation()->set_z(q.z());
-  p->mutable_orientation()->set_w(q.w());
-}
 
 void SetColor(double r, double g, double b, double a, foxglove::Color* c) {
   c->set_r(r);
@@ -44,8 +34,7 @@ void AddPoint(const Eigen::Vector3d& p, foxglove::LinePrimitive* line) {
 const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const GraphScene& scene) {
   foxglove::SceneUpdate update;
   foxglove::SceneEntity* e = update.add_entities();
-  e->mutable_timestamp()->set_seconds(time.nanoseconds() / 1000000000);
-  e->mutable_timestamp()->set_nanos(static_cast<int32_t>(time.nanoseconds() % 1000000000));
+  SetFoxgloveTime(time, e->mutable_timestamp());
   e->set_frame_id(EstimateEncoder::kMapFrame);
   e->set_id(std::string("graph/") + robot);
   foxglove::KeyValuePair* kv = e->add_metadata();
@@ -66,7 +55,7 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = axes;
     T.translation() = n.T_global.translation();
-    SetPose(T, s->mutable_pose());
+    SetFoxglovePose(T, s->mutable_pose());
     const Eigen::Vector3d d = (4.0 * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt()).cwiseMax(kMinOriginDiameter);
     s->mutable_size()->set_x(d.x());
     s->mutable_size()->set_y(d.y());
@@ -75,7 +64,7 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
     foxglove::TextPrimitive* t = e->add_texts();
     Eigen::Isometry3d label = Eigen::Isometry3d::Identity();
     label.translation() = n.T_global.translation() + Eigen::Vector3d(0.0, 0.0, 0.15);
-    SetPose(label, t->mutable_pose());
+    SetFoxglovePose(label, t->mutable_pose());
     t->set_billboard(true);
     t->set_font_size(14.0);
     t->set_scale_invariant(true);
@@ -85,7 +74,7 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
   for (const GraphScene::Node& n : scene.poses) {
     position[n.key] = n.T_global.translation();
     foxglove::SpherePrimitive* s = e->add_spheres();
-    SetPose(n.T_global, s->mutable_pose());
+    SetFoxglovePose(n.T_global, s->mutable_pose());
     s->mutable_size()->set_x(kPoseDiameter);
     s->mutable_size()->set_y(kPoseDiameter);
     s->mutable_size()->set_z(kPoseDiameter);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "daemon/foxglove_fields.h"
 #include "foxglove/Log.pb.h"
 
 namespace cairn {
@@ -30,8 +31,7 @@ void LiveLogSink::sink_it_(const spdlog::details::log_msg& msg) {
   if (!publish_) return;
   const int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(msg.time.time_since_epoch()).count();
   foxglove::Log log;
-  log.mutable_timestamp()->set_seconds(ns / 1000000000);
-  log.mutable_timestamp()->set_nanos(static_cast<int32_t>(ns % 1000000000));
+  SetFoxgloveTime(Timestamp::FromNanoseconds(ns), log.mutable_timestamp());
   log.set_level(LevelOf(msg.level));
   log.set_message(std::string(msg.payload.data(), msg.payload.size()));
   log.set_name(name_);

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cairn/sensors.pb.h"
+#include "daemon/foxglove_fields.h"
 #include "foxglove/CompressedImage.pb.h"
 #include "foxglove/FrameTransform.pb.h"
 #include "foxglove/Grid.pb.h"
@@ -99,8 +100,7 @@ const std::string& SampleEncoder::StereoInfo(const StereoFrame& f) {
 
 const std::string& SampleEncoder::Image(const cairn::Image& img, Timestamp t, const char* frame_id) {
   foxglove::RawImage m;
-  m.mutable_timestamp()->set_seconds(t.nanoseconds() / 1000000000);
-  m.mutable_timestamp()->set_nanos(static_cast<int32_t>(t.nanoseconds() % 1000000000));
+  SetFoxgloveTime(t, m.mutable_timestamp());
   m.set_frame_id(frame_id);
   m.set_width(static_cast<uint32_t>(img.width));
   m.set_height(static_cast<uint32_t>(img.height));
@@ -136,8 +136,7 @@ bool SampleEncoder::Compressed(const cairn::Image& img, Timestamp t, const char*
     return false;
   }
   foxglove::CompressedImage m;
-  m.mutable_timestamp()->set_seconds(t.nanoseconds() / 1000000000);
-  m.mutable_timestamp()->set_nanos(static_cast<int32_t>(t.nanoseconds() % 1000000000));
+  SetFoxgloveTime(t, m.mutable_timestamp());
   m.set_frame_id(frame_id);
   m.set_format(jpeg ? "jpeg" : "png");
   m.set_data(codec_buffer_.data(), codec_buffer_.size());
