@@ -125,13 +125,11 @@ void EstimationStage::OnFrameSwitch(const FilterSwitchRequest& request) {
       T_first_frame_[old_id % T_first_frame_.size()] * r.transform.T_old_new;
   ++report_.frame_switches;
   ++report_.switch_reasons[static_cast<size_t>(request.reason)];
-  if (switch_events_ != nullptr &&
-      !switch_events_->TryPush(FrameSwitchEvent{r.time, r.old_frame_id, r.new_frame_id, r.transform})) {
-    ++report_.switch_events_dropped;
-  }
+  const FrameSwitchEvent event{r.time, r.old_frame_id, r.new_frame_id, r.transform};
+  if (switch_events_ != nullptr && !switch_events_->TryPush(event)) ++report_.switch_events_dropped;
   if (graph_inputs_ != nullptr) {
     graph_input_.kind = GraphInput::Kind::kFrameSwitch;
-    graph_input_.frame_switch = FrameSwitchEvent{r.time, r.old_frame_id, r.new_frame_id, r.transform};
+    graph_input_.frame_switch = event;
     if (!graph_inputs_->TryPush(graph_input_)) ++report_.graph_inputs_dropped;
   }
 }

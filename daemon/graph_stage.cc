@@ -1,6 +1,6 @@
 #include "daemon/graph_stage.h"
 
-#include <chrono>
+#include "hal/monotonic_clock.h"
 
 namespace cairn {
 namespace {
@@ -63,10 +63,10 @@ bool GraphStage::Add(const SlamFactor& f) {
 }
 
 void GraphStage::Update() {
-  const auto t0 = std::chrono::steady_clock::now();
+  const MonotonicClock clock;
+  const Timestamp start = clock.Now();
   const SlamUpdateStats stats = graph_.Update();
-  update_time_.Record(Duration::Nanoseconds(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0).count()));
+  update_time_.Record(clock.Now() - start);
   if (stats.solved) ++report_.solves;
   if (stats.reinitialized) ++report_.reinitializations;
 }
@@ -97,8 +97,7 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
     return;
   }
   estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
-  last_time_ = e.time;
-  if (valid_seen_++ % static_cast<uint64_t>(options_.pose_every) != 0) return;
+  if ((estimates_.size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
   SlamFactor v;
   v.kind = FactorKind::kFilterEstimate;
   v.a = OriginKey(e.frame_id);

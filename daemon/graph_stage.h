@@ -68,7 +68,7 @@ class GraphStage {
   GraphStageReport report() const;
   char robot() const { return robot_; }
   // Time of the last estimate placed, and the number of submap origins (cheap, for live updates).
-  Timestamp last_time() const { return last_time_; }
+  Timestamp last_time() const { return estimates_.empty() ? Timestamp() : estimates_.back().time; }
   uint64_t submap_origins() const { return report_.submap_origins; }
   const LatencyHistogram& update_time() const { return update_time_; }
   // T_global_frame of every local frame in the graph (global = the first frame).
@@ -96,7 +96,6 @@ class GraphStage {
   SlamGraph graph_;
   char robot_ = 'a';
   bool started_ = false;
-  uint64_t valid_seen_ = 0;
   uint64_t next_pose_ = 0;
   struct Placed {
     Timestamp time;
@@ -104,7 +103,6 @@ class GraphStage {
     Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
   };
   std::vector<Placed> estimates_;
-  Timestamp last_time_;
   std::map<uint64_t, Eigen::Matrix3d> origin_covariance_;  // of the live view, as last computed
   LatencyHistogram update_time_;
   GraphStageReport report_;

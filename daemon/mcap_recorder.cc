@@ -25,9 +25,8 @@ Status McapRecorder::EnsureOpen(Timestamp time) {
   report_.files.push_back(path);
   // Every file is self-contained: schemas and channels again after each rotation.
   std::map<const google::protobuf::Descriptor*, uint16_t> schema_ids;
-  for (int t = 0; t < kTelemetryTopicCount; ++t) {
-    const auto topic = static_cast<TelemetryTopic>(t);
-    const auto* d = TelemetryTopicDescriptor(topic);
+  // A protobuf channel; messages sharing a type share its schema record.
+  const auto add_channel = [&](const char* topic, const google::protobuf::Descriptor* d) -> Expected<uint16_t> {
     if (schema_ids.count(d) == 0) {
       const std::string set = ProtobufFileDescriptorSet(d);
       auto id = writer_.AddSchema(d->full_name(), "protobuf",
@@ -35,16 +34,16 @@ Status McapRecorder::EnsureOpen(Timestamp time) {
       if (!id.ok()) return id.status();
       schema_ids[d] = *id;
     }
-    auto ch = writer_.AddChannel(TelemetryTopicName(topic), "protobuf", schema_ids[d]);
+    return writer_.AddChannel(topic, "protobuf", schema_ids[d]);
+  };
+  for (int t = 0; t < kTelemetryTopicCount; ++t) {
+    const auto topic = static_cast<TelemetryTopic>(t);
+    auto ch = add_channel(TelemetryTopicName(topic), TelemetryTopicDescriptor(topic));
     if (!ch.ok()) return ch.status();
     channel_[t] = *ch;
   }
   if (!calibration_.empty()) {
-    const auto* d = msg::Calibration::descriptor();
-    const std::string set = ProtobufFileDescriptorSet(d);
-    auto schema = writer_.AddSchema(d->full_name(), "protobuf", {reinterpret_cast<const uint8_t*>(set.data()), set.size()});
-    if (!schema.ok()) return schema.status();
-    auto ch = writer_.AddChannel("/calibration", "protobuf", *schema);
+    auto ch = add_channel("/calibration", msg::Calibration::descriptor());
     if (!ch.ok()) return ch.status();
     const uint64_t ns = static_cast<uint64_t>(time.nanoseconds());
     CAIRN_RETURN_IF_ERROR(writer_.Write(*ch, 0, ns, ns, {reinterpret_cast<const uint8_t*>(calibration_.data()),

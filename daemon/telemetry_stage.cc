@@ -36,24 +36,20 @@ void TelemetryStage::EnableRecording(std::string directory, const RecordingOptio
 
 Status TelemetryStage::EnableLiveStream(const std::string& robot_name, const LiveStreamOptions& options) {
   live_ = std::make_unique<FoxgloveServer>("cairnd " + robot_name);
-  for (int t = 0; t < kTelemetryTopicCount; ++t) {
-    const auto topic = static_cast<TelemetryTopic>(t);
-    const auto* d = TelemetryTopicDescriptor(topic);
-    const std::string set = ProtobufFileDescriptorSet(d);
-    live_channel_[t] = live_->AddChannel(FoxgloveChannel{
-        0, TelemetryTopicName(topic), "protobuf", d->full_name(),
-        FoxgloveServer::Base64({reinterpret_cast<const uint8_t*>(set.data()), set.size()}), "protobuf"});
-  }
-  diagnostics_channel_ = live_->AddChannel(FoxgloveChannel{
-      0, "/diagnostics", "json", "cairn.Diagnostics",
-      R"({"type":"object","properties":{"status":{"type":"string"},"time_ns":{"type":"integer"}}})",
-      "jsonschema"});
   const auto add = [this](const char* topic, const google::protobuf::Descriptor* d) {
     const std::string set = ProtobufFileDescriptorSet(d);
     return live_->AddChannel(FoxgloveChannel{0, topic, "protobuf", d->full_name(),
                                              FoxgloveServer::Base64({reinterpret_cast<const uint8_t*>(set.data()), set.size()}),
                                              "protobuf"});
   };
+  for (int t = 0; t < kTelemetryTopicCount; ++t) {
+    const auto topic = static_cast<TelemetryTopic>(t);
+    live_channel_[t] = add(TelemetryTopicName(topic), TelemetryTopicDescriptor(topic));
+  }
+  diagnostics_channel_ = live_->AddChannel(FoxgloveChannel{
+      0, "/diagnostics", "json", "cairn.Diagnostics",
+      R"({"type":"object","properties":{"status":{"type":"string"},"time_ns":{"type":"integer"}}})",
+      "jsonschema"});
   graph_channel_ = add("/graph", foxglove::SceneUpdate::descriptor());
   log_channel_ = add("/log", foxglove::Log::descriptor());
   live_->SetLatched(graph_channel_, 1);
