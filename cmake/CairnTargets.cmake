@@ -11,6 +11,35 @@ function(cairn_warnings target)
   endif()
 endfunction()
 
+# Precompiled headers (CAIRN_PCH, on in the sanitizer presets, which CI builds from scratch): the
+# standard library, Eigen's Core and Geometry and, for tests, GoogleTest are parsed once per build
+# instead of once per file. Builds without it (release, cross) keep every file's own includes
+# honest. cairn_define_pch() makes the two header-only targets the others reuse.
+function(cairn_define_pch)
+  if(NOT CAIRN_PCH)
+    return()
+  endif()
+  set(common <algorithm> <array> <atomic> <chrono> <cmath> <cstdint> <cstring> <functional> <map>
+             <memory> <mutex> <optional> <string> <string_view> <thread> <unordered_map> <utility>
+             <variant> <vector> <Eigen/Core> <Eigen/Geometry>)
+  add_library(cairn_pch STATIC ${PROJECT_SOURCE_DIR}/cmake/pch_anchor.cc)
+  target_link_libraries(cairn_pch PRIVATE Eigen3::Eigen)
+  target_precompile_headers(cairn_pch PRIVATE ${common})
+  cairn_warnings(cairn_pch)
+  if(TARGET GTest::gtest)
+    add_library(cairn_test_pch STATIC ${PROJECT_SOURCE_DIR}/cmake/pch_anchor.cc)
+    target_link_libraries(cairn_test_pch PRIVATE Eigen3::Eigen GTest::gtest)
+    target_precompile_headers(cairn_test_pch PRIVATE ${common} <gtest/gtest.h>)
+    cairn_warnings(cairn_test_pch)
+  endif()
+endfunction()
+
+function(cairn_use_pch target pch)
+  if(CAIRN_PCH AND TARGET ${pch})
+    target_precompile_headers(${target} REUSE_FROM ${pch})
+  endif()
+endfunction()
+
 # cairn_library(NAME SOURCES ... DEPS ...): a library rooted at the source tree so that includes
 # read "hal/timestamp.h".
 function(cairn_library name)
@@ -20,6 +49,7 @@ function(cairn_library name)
   target_include_directories(${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>)
   target_link_libraries(${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   cairn_warnings(${name})
+  cairn_use_pch(${name} cairn_pch)
 endfunction()
 
 # cairn_test(NAME SOURCES ... DEPS ... [LABELS ...]): one GoogleTest binary, each TEST a ctest entry.
@@ -41,6 +71,7 @@ function(cairn_test name)
     CAIRN_TEST_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
     CAIRN_TEST_BINARY_DIR="${PROJECT_BINARY_DIR}")
   cairn_warnings(${name})
+  cairn_use_pch(${name} cairn_test_pch)
   if("concurrency" IN_LIST ARG_LABELS)
     add_dependencies(concurrency_tests ${name})
   endif()

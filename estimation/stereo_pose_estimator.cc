@@ -259,8 +259,10 @@ PoseEstimate StereoPoseEstimator::Estimate(std::span<const StereoPoint> kf, std:
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
   out.T_kf_cur.linear() = R;
   out.T_kf_cur.translation() = t;
-  const double sigma_t = std::sqrt(out.covariance.topLeftCorner<3, 3>().eigenvalues().real().maxCoeff());
-  const double sigma_r = std::sqrt(out.covariance.bottomRightCorner<3, 3>().eigenvalues().real().maxCoeff());
+  // Symmetric blocks: the self-adjoint solver (the general one is costly to compile).
+  const Eigen::Matrix3d cov_t = out.covariance.topLeftCorner<3, 3>(), cov_r = out.covariance.bottomRightCorner<3, 3>();
+  const double sigma_t = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov_t, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
+  const double sigma_r = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov_r, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
   if (sigma_t > options_.max_sigma_translation || sigma_r * 180.0 / M_PI > options_.max_sigma_rotation_deg) {
     out.status = VoStatus::kDegenerate;
     return out;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
@@ -30,6 +31,39 @@ Eigen::Isometry3d AlignFourDof(const std::vector<Eigen::Vector3d>& gt, const std
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = Eigen::AngleAxisd(std::atan2(s, c), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = mg - T.linear() * me;
+  return T;
+}
+
+// Rotation and translation that best map `est` positions onto `gt` ones (least squares, Umeyama
+// 1991 without scale), from the 3x3 cross-covariance only: fixed-size matrices keep this file
+// cheap to compile. Fewer than 3 distinct positions, or all on a line, leave the rotation free:
+// then `fallback` (the first poses' alignment) is used.
+Eigen::Isometry3d AlignSe3(const std::vector<Eigen::Vector3d>& gt, const std::vector<Eigen::Vector3d>& est,
+                           const Eigen::Isometry3d& fallback) {
+  const double n = static_cast<double>(gt.size());
+  Eigen::Vector3d mg = Eigen::Vector3d::Zero(), me = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < gt.size(); ++i) {
+    mg += gt[i];
+    me += est[i];
+  }
+  mg /= n;
+  me /= n;
+  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero(), scatter = Eigen::Matrix3d::Zero();
+  for (size_t i = 0; i < gt.size(); ++i) {
+    const Eigen::Vector3d a = est[i] - me, b = gt[i] - mg;
+    cross += b * a.transpose();
+    scatter += a * a.transpose();
+  }
+  // Singular values of the centred positions are the square roots of the scatter's eigenvalues.
+  const Eigen::Vector3d lambda = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+  const double s1 = std::sqrt(std::max(lambda(1), 0.0)), s0 = std::sqrt(std::max(lambda(2), 0.0));
+  if (gt.size() < 3 || s1 < 1e-6 * std::max(1.0, s0)) return fallback;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross / n, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d d = Eigen::Vector3d::Ones();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) d(2) = -1.0;  // no reflection
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = svd.matrixU() * d.asDiagonal() * svd.matrixV().transpose();
   T.translation() = mg - T.linear() * me;
   return T;
 }
@@ -80,23 +114,9 @@ Expected<TrajectoryEvalResult> EvaluateTrajectory(const Trajectory& ground_truth
     pe.push_back(E[i].translation());
   }
   switch (options.alignment) {
-    case TrajectoryAlignment::kSe3: {
-      Eigen::Matrix3Xd a(3, pe.size()), b(3, pg.size());
-      for (size_t i = 0; i < pe.size(); ++i) {
-        a.col(static_cast<Eigen::Index>(i)) = pe[i];
-        b.col(static_cast<Eigen::Index>(i)) = pg[i];
-      }
-      // Fewer than 3 distinct positions (or all on a line) leave the rotation free: align by the
-      // first pose instead.
-      Eigen::Matrix3Xd centered = a.colwise() - a.rowwise().mean();
-      const Eigen::JacobiSVD<Eigen::Matrix3Xd> svd(centered);
-      if (pe.size() < 3 || svd.singularValues()(1) < 1e-6 * std::max(1.0, svd.singularValues()(0))) {
-        r.T_gt_est = G.front() * E.front().inverse();
-      } else {
-        r.T_gt_est.matrix() = Eigen::umeyama(a, b, false);
-      }
+    case TrajectoryAlignment::kSe3:
+      r.T_gt_est = AlignSe3(pg, pe, G.front() * E.front().inverse());
       break;
-    }
     case TrajectoryAlignment::kFourDof:
       r.T_gt_est = AlignFourDof(pg, pe);
       break;

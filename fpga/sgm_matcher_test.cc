@@ -2,17 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <hwy/targets.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "fpga/disparity_evaluator.h"
+#include "fpga/sgm_kernels.h"
 #include "fpga/opencv_sgbm_matcher.h"
 #include "fpga/stereo_depth.h"
 #include "fpga/stereo_image_io.h"
@@ -95,7 +99,9 @@ std::string DataDir() {
   return d != nullptr ? d : "";
 }
 
-TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
+// Every SIMD target this machine can run that the kernels are compiled for (fpga/CMakeLists.txt
+// lists them), each against the scalar golden model.
+TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImagesForEveryTarget) {
   struct Case {
     int w, h, min_d, num_d, paths, cw, ch, threads;
     bool raster = false;
@@ -112,42 +118,67 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImages) {
                         {50, 2, -16, 64, 4, 9, 7, 2},       {31, 12, 5, 48, 4, 3, 3, 1},
                         {90, 25, 0, 64, 4, 5, 5, 2, false, 60},
                         {61, 14, -4, 48, 4, 7, 7, 2, false, 70}};
-  uint32_t seed = 1;
-  for (const Case& c : cases) {
-    // Random left image; the right one is the left shifted by 5 px plus strong noise, so that
-    // both clear matches and ambiguous ones occur.
-    const auto l = RandomImage(c.w, c.h, seed++), noise = RandomImage(c.w, c.h, seed++);
-    std::vector<uint8_t> r(l.size());
-    for (int y = 0; y < c.h; ++y) {
-      for (int x = 0; x < c.w; ++x) {
-        const size_t i = static_cast<size_t>(y) * c.w + x;
-        const int v = l[static_cast<size_t>(y) * c.w + std::min(c.w - 1, x + 5)] + noise[i] / 4 - 32;
-        r[i] = static_cast<uint8_t>(std::clamp(v, 0, 255));
+  struct RestoreTargets {
+    ~RestoreTargets() { hwy::SetSupportedTargetsForTest(0); }
+  } restore;  // also when an ASSERT returns early
+  const int64_t supported = hwy::SupportedTargets();
+  std::set<std::string> tested;
+  for (const int64_t target : {HWY_AVX3_DL, HWY_AVX3, HWY_AVX2, HWY_SSE4, HWY_SSSE3, HWY_SVE2, HWY_SVE,
+                               HWY_NEON, HWY_EMU128, HWY_SCALAR}) {
+    if ((supported & target) == 0) continue;
+    hwy::SetSupportedTargetsForTest(target);
+    const std::string name = SimdTargetName();  // the best compiled target it allows
+    if (!tested.insert(name).second) continue;
+    SCOPED_TRACE(name);
+    uint32_t seed = 1;
+    for (const Case& c : cases) {
+      // Random left image; the right one is the left shifted by 5 px plus strong noise, so that
+      // both clear matches and ambiguous ones occur.
+      const auto l = RandomImage(c.w, c.h, seed++), noise = RandomImage(c.w, c.h, seed++);
+      std::vector<uint8_t> r(l.size());
+      for (int y = 0; y < c.h; ++y) {
+        for (int x = 0; x < c.w; ++x) {
+          const size_t i = static_cast<size_t>(y) * c.w + x;
+          const int v = l[static_cast<size_t>(y) * c.w + std::min(c.w - 1, x + 5)] + noise[i] / 4 - 32;
+          r[i] = static_cast<uint8_t>(std::clamp(v, 0, 255));
+        }
       }
+      SgmOptions o;
+      o.median = seed % 4 != 1;
+      o.subpixel = seed % 6 != 1;
+      o.min_disparity = c.min_d;
+      o.num_disparities = c.num_d;
+      o.paths = c.paths;
+      o.raster_paths = c.raster;
+      o.census_width = c.cw;
+      o.census_height = c.ch;
+      o.threads = c.threads;
+      o.p2 = c.p2;
+      o.uniqueness_percent = seed % 3 == 0 ? 0 : (seed % 3 == 1 ? 5 : 12);
+      if (c.h < 4) o.speckle_max_size = 0;  // every region of one or two rows is a speckle
+      o.backend = SgmBackend::kScalar;
+      const auto a = RunSgm(o, l, r, c.w, c.h);
+      o.backend = SgmBackend::kSimd;
+      const auto b = RunSgm(o, l, r, c.w, c.h);
+      ASSERT_EQ(a.disparity.size(), static_cast<size_t>(c.w) * c.h);
+      EXPECT_EQ(a.disparity, b.disparity) << c.w << "x" << c.h << " d " << c.min_d << "+" << c.num_d
+                                          << " paths " << c.paths << " raster " << c.raster;
+      const long valid = std::count_if(a.disparity.begin(), a.disparity.end(),
+                                        [](int16_t d) { return d != kInvalidDisparity; });
+      EXPECT_GT(valid, 0) << c.w << "x" << c.h << " d " << c.min_d << "+" << c.num_d;
     }
-    SgmOptions o;
-    o.median = seed % 4 != 1;
-    o.subpixel = seed % 6 != 1;
-    o.min_disparity = c.min_d;
-    o.num_disparities = c.num_d;
-    o.paths = c.paths;
-    o.raster_paths = c.raster;
-    o.census_width = c.cw;
-    o.census_height = c.ch;
-    o.threads = c.threads;
-    o.p2 = c.p2;
-    o.uniqueness_percent = seed % 3 == 0 ? 0 : (seed % 3 == 1 ? 5 : 12);
-    if (c.h < 4) o.speckle_max_size = 0;  // every region of one or two rows is a speckle
-    o.backend = SgmBackend::kScalar;
-    const auto a = RunSgm(o, l, r, c.w, c.h);
-    o.backend = SgmBackend::kSimd;
-    const auto b = RunSgm(o, l, r, c.w, c.h);
-    ASSERT_EQ(a.disparity.size(), static_cast<size_t>(c.w) * c.h);
-    EXPECT_EQ(a.disparity, b.disparity) << c.w << "x" << c.h << " d " << c.min_d << "+" << c.num_d
-                                        << " paths " << c.paths << " raster " << c.raster;
-    const long valid = std::count_if(a.disparity.begin(), a.disparity.end(),
-                                      [](int16_t d) { return d != kInvalidDisparity; });
-    EXPECT_GT(valid, 0) << c.w << "x" << c.h << " d " << c.min_d << "+" << c.num_d;
+  }
+  std::string names;
+  for (const std::string& n : tested) names += " " + n;
+  std::printf("SIMD targets checked against scalar:%s\n", names.c_str());
+  if (supported & HWY_AVX2) {
+    EXPECT_TRUE(tested.count("AVX2")) << names;
+  }
+  if (supported & HWY_SSE4) {
+    EXPECT_TRUE(tested.count("SSE4")) << names;
+  }
+  if (supported & HWY_NEON) {
+    EXPECT_TRUE(tested.count("NEON")) << names;
   }
 }
 
