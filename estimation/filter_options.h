@@ -41,6 +41,9 @@ struct FilterOptions {
   double init_max_gyro = 0.2;        // rad/s; larger rates (beyond any plausible bias) are motion
   double init_max_gyro_dev = 0.01;   // rad/s; deviation from the window's mean rate
   double init_max_accel_dev = 0.1;   // m/s^2; deviation from the window mean and of |a| from g
+  // m/s; wheels reporting a faster body speed (and one well outside its noise) restart the still
+  // window: driving at constant speed looks still to the IMU.
+  double init_max_wheel_speed = 0.02;
   double init_sigma_roll_pitch = 0.01;  // rad
   double init_sigma_velocity = 0.02;    // m/s
   double init_sigma_accel_bias = 0.1;   // m/s^2
@@ -74,6 +77,7 @@ struct FilterOptions {
     v.Number("init_max_gyro", init_max_gyro, 0.0, 10.0, "rad/s");
     v.Number("init_max_gyro_dev", init_max_gyro_dev, 0.0, 10.0, "rad/s");
     v.Number("init_max_accel_dev", init_max_accel_dev, 0.0, 20.0, "m/s^2");
+    v.Number("init_max_wheel_speed", init_max_wheel_speed, 0.0, 10.0, "m/s");
     v.Number("init_sigma_roll_pitch", init_sigma_roll_pitch, 1e-6, 1.0, "rad");
     v.Number("init_sigma_velocity", init_sigma_velocity, 1e-6, 10.0, "m/s");
     v.Number("init_sigma_accel_bias", init_sigma_accel_bias, 1e-6, 10.0, "m/s^2");

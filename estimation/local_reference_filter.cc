@@ -547,7 +547,17 @@ FilterResult LocalReferenceFilter::ApplyRelativePose(CloneId keyframe, CloneId c
 }
 
 FilterResult LocalReferenceFilter::ApplyWheelOdometry(const BodyVelocity& velocity) {
-  if (!initialized_) return FilterResult::kNotInitialized;
+  if (!initialized_) {
+    // Turning wheels: the IMU's quiet window is not a still one (see StaticInitializer). Encoder
+    // noise must not count as motion: the speed must also be far outside its covariance
+    // (chi-square, 2 degrees of freedom, 99.97 %).
+    if (options_.wheel_enabled && velocity.v_xy.allFinite() && CovarianceOk(velocity.covariance) &&
+        velocity.v_xy.norm() > options_.init_max_wheel_speed &&
+        velocity.v_xy.dot(velocity.covariance.inverse() * velocity.v_xy) > 16.0) {
+      initializer_.MotionSeen();
+    }
+    return FilterResult::kNotInitialized;
+  }
   FilterResult r = FilterResult::kApplied;
   if (!options_.wheel_enabled) r = FilterResult::kRejectedDisabled;
   else if (!velocity.v_xy.allFinite()) r = FilterResult::kRejectedNotFinite;
@@ -565,9 +575,9 @@ FilterResult LocalReferenceFilter::ApplyWheelOdometry(const BodyVelocity& veloci
 }
 
 FilterResult LocalReferenceFilter::ApplyWheelOdometry(const WheelOdometrySample& sample) {
-  if (!initialized_) return FilterResult::kNotInitialized;
   BodyVelocity v;
   if (options_.wheel_enabled && !WheelBodyVelocity(sample, wheels_, options_.wheel_lateral_sigma, &v)) {
+    if (!initialized_) return FilterResult::kNotInitialized;
     Count(FilterResult::kRejectedInvalid, true);
     return FilterResult::kRejectedInvalid;
   }

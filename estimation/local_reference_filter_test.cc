@@ -410,6 +410,56 @@ TEST(LocalReferenceFilterTest, StaticInitializationAndMotionPolicy) {
   EXPECT_FALSE(g.Output().initialized);
 }
 
+// A rover rolling at constant speed on flat ground gives a quiet IMU: its wheels must hold the
+// initialization back until it stops.
+TEST(LocalReferenceFilterTest, TurningWheelsHoldStaticInitializationBack) {
+  ImuSimulatorOptions so;
+  so.noise = testing::TestNoise();
+  so.motion_scale = 0.0;
+  so.seed = 6;
+  ImuSimulator sim(so);
+  FilterOptions o;
+  o.wheel_enabled = true;
+  LocalReferenceFilter f(o, testing::TestCalibration());
+  BodyVelocity rolling;
+  rolling.v_xy = Eigen::Vector2d(0.4, 0.0);
+  rolling.covariance = Eigen::Matrix2d::Identity() * 1e-4;
+  BodyVelocity stopped = rolling;
+  stopped.v_xy.setZero();
+  int n = 0;
+  FilterResult r = FilterResult::kInitializing;
+  // 3 s of quiet IMU data with the wheels turning (wheel samples at 20 Hz), then stopped.
+  while (r == FilterResult::kInitializing && n < 2000) {
+    ImuSample s = sim.Next();
+    if (n % 10 == 0) {
+      BodyVelocity& v = n < 600 ? rolling : stopped;
+      v.time = s.time;
+      EXPECT_EQ(f.ApplyWheelOdometry(v), FilterResult::kNotInitialized);
+    }
+    r = f.Propagate(s);
+    ++n;
+  }
+  ASSERT_EQ(r, FilterResult::kApplied);
+  // The window starts with the first block after the wheels stop and needs 1 s of data.
+  EXPECT_GE(n, 590 + 200);
+  EXPECT_LE(n, 600 + 200 + 22);
+  // Without wheels turning the same data initializes after the first second.
+  LocalReferenceFilter g(o, testing::TestCalibration());
+  ImuSimulator again(so);
+  int m = 0;
+  r = FilterResult::kInitializing;
+  while (r == FilterResult::kInitializing && m < 2000) {
+    ImuSample s = again.Next();
+    if (m % 10 == 0) {
+      stopped.time = s.time;
+      g.ApplyWheelOdometry(stopped);
+    }
+    r = g.Propagate(s);
+    ++m;
+  }
+  EXPECT_LE(m, 200 + 22);
+}
+
 TEST(LocalReferenceFilterTest, ClonesAreBoundedAndReleasedClonesMarginalized) {
   ScenarioOptions s;
   s.duration = 3.0;

@@ -13,6 +13,11 @@ void StaticInitializer::Reset() {
   block_gyro_.setZero();
 }
 
+void StaticInitializer::MotionSeen() {
+  if (count_ > 0) ++restarts_;
+  Reset();
+}
+
 bool StaticInitializer::Add(const ImuSample& sample) {
   if (block_count_ == 0) block_start_ = sample.time;
   if (count_ == 0 && block_count_ == 0) start_ = sample.time;

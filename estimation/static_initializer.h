@@ -6,7 +6,8 @@
 // idling on the ground) does not count as motion. Policy when the robot moves: a block whose mean
 // rate or specific force leaves the window's mean (init_max_gyro_dev, init_max_accel_dev), whose
 // mean rate exceeds init_max_gyro or whose mean specific force is further than
-// init_max_accel_dev from gravity in magnitude restarts the window. The filter
+// init_max_accel_dev from gravity in magnitude restarts the window, and so do wheels that turn
+// (init_max_wheel_speed): a rover driving at constant speed looks still to its IMU. The filter
 // reports "not initialized" until a full window has been collected; it never initializes from
 // moving data, because a wrong gravity direction would corrupt every later estimate. A robot that
 // cannot stand still is initialized explicitly with LocalReferenceFilter::Initialize().
@@ -25,6 +26,8 @@ class StaticInitializer {
 
   // Returns true when the sample completes a still window.
   bool Add(const ImuSample& sample);
+  // Another sensor (the wheels) saw motion: the window restarts.
+  void MotionSeen();
   void Reset();
 
   const Eigen::Vector3d& mean_accel() const { return mean_accel_; }

@@ -69,9 +69,10 @@ const StampedPose& Nearest(const Trajectory& t, Timestamp time) {
 
 TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
   const std::string out = testing::FreshTempDir("cairnd_mapping");
-  // 0.7 m submaps, so 0.4 m/s over 6 s (less the filter's start) partitions the drive into several.
+  // 0.45 m submaps, so 0.4 m/s over the last 4 s of 6 (the rover stands for 2 s) partitions the
+  // drive into several.
   auto args = RoverArgs(out + "/a", 6.0, 0.5);
-  args.insert(args.end(), {"--set", "mapping.partition.max_distance=0.7"});
+  args.insert(args.end(), {"--set", "mapping.partition.max_distance=0.45"});
   const auto r = RunProcess(args, LongRun());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue s = JsonValue::ParseFile(out + "/a/summary.json");
@@ -165,7 +166,7 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
 
   // The same run again: identical summary and identical submap bytes.
   auto again = RoverArgs(out + "/b", 6.0, 0.5);
-  again.insert(again.end(), {"--set", "mapping.partition.max_distance=0.7"});
+  again.insert(again.end(), {"--set", "mapping.partition.max_distance=0.45"});
   const auto r2 = RunProcess(again, LongRun());
   ASSERT_EQ(r2.exit_code, 0) << r2.output;
   EXPECT_EQ(ReadBytes(out + "/a/summary.json"), ReadBytes(out + "/b/summary.json"));

@@ -84,8 +84,11 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
   };
   const int n = static_cast<int>(std::ceil(duration / kKnot)) + 4;
   std::vector<Eigen::Vector3d> pos, euler;
+  // It stands still before it drives off, as a rover does until its estimator has initialized
+  // (wheels turning hold the filter's static initialization back).
+  const double still = 2.0;  // s
   for (int i = 0; i < n; ++i) {
-    const double s = speed * kKnot * (i - 1);
+    const double s = speed * std::max(0.0, kKnot * (i - 1) - still);
     const Eigen::Vector2d p = xy_at(s), ahead = xy_at(s + 0.05) - xy_at(s - 0.05);
     const double yaw = std::atan2(ahead.y(), ahead.x());
     const Eigen::Rotation2Dd R(yaw);
