@@ -156,7 +156,7 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
     if (s.clones[u].id == kNoClone || !s.cross_current[u]) continue;
     ApplyTransitionT<6>(f, &s.P(CloneIndex(j), 0), kStateDim);
   }
-  s.cross_pending = true;
+  MarkDeferred(s);
 
   s.time = t1;
   s.accel = accel1;
