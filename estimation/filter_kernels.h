@@ -17,6 +17,27 @@ inline V2 Load(const double* p) {
 }
 inline void Store(double* p, V2 v) { std::memcpy(p, &v, sizeof(v)); }
 
+// Four doubles, for the kernels built twice (CAIRN_WIDE_KERNEL): AVX2 where the CPU has it, else
+// lowered to pairs of two-double operations. Never passed by value (that would change the ABI
+// between the two builds): accessed in place through the unaligned, aliasing variant (a memcpy
+// through a stack copy costs a store-forwarding stall per load).
+typedef double V4 __attribute__((vector_size(32)));
+typedef double V4u __attribute__((vector_size(32), aligned(8), may_alias));
+typedef double V2u __attribute__((vector_size(16), aligned(8), may_alias));
+// By lane count (as a template argument a typedef would lose its attributes).
+template <int Lanes> struct Unaligned;
+template <> struct Unaligned<1> { using type = double; };
+template <> struct Unaligned<2> { using type = V2u; };
+template <> struct Unaligned<4> { using type = V4u; };
+
+// A kernel compiled for AVX2 and for the baseline ISA, chosen once at load time by the CPU: the
+// result on one machine does not depend on the path (no FMA, the same operations lane by lane).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CAIRN_WIDE_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define CAIRN_WIDE_KERNEL
+#endif
+
 enum Mode { kSet, kAdd, kSub };
 
 // R (rows x K) =, += or -= A (rows x Inner) * B (Inner x K). All column-major with leading
