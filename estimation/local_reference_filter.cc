@@ -58,6 +58,7 @@ LocalReferenceFilter::LocalReferenceFilter(const FilterOptions& options, const I
     : options_(options),
       calibration_(imu),
       wheels_(wheels),
+      T_imu_body_(imu.T_body_imu.inverse()),
       propagator_(ImuNoise::FromCalibration(imu), options.gravity),
       initializer_(options),
       imu_(static_cast<size_t>(std::clamp<int64_t>(options.imu_buffer, 16, kMaxImuBuffer))),
@@ -438,7 +439,7 @@ void LocalReferenceFilter::WriteHistory(uint64_t k) {
   h.T_frame_body = Eigen::Isometry3d::Identity();
   h.T_frame_body.linear() = state_.q.toRotationMatrix();
   h.T_frame_body.translation() = state_.p;
-  h.T_frame_body = h.T_frame_body * calibration_.T_body_imu.inverse();
+  h.T_frame_body = h.T_frame_body * T_imu_body_;
   h.covariance.topLeftCorner<3, 3>() = state_.P.block<3, 3>(kP, kP);
   h.covariance.topRightCorner<3, 3>() = state_.P.block<3, 3>(kP, kTheta);
   h.covariance.bottomLeftCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kP);
