@@ -5,26 +5,13 @@
 // vectorize on every target (SSE2, NEON) without ISA-specific flags; on x86-64 the main ones are
 // also built for AVX2 and picked at load time.
 
-#include <cstring>
-
 namespace cairn::kernels {
 
-typedef double V2 __attribute__((vector_size(16)));
-
-inline V2 Load(const double* p) {
-  V2 v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
-inline void Store(double* p, V2 v) { std::memcpy(p, &v, sizeof(v)); }
-
-// Four doubles, for the kernels built twice (CAIRN_WIDE_KERNEL): AVX2 where the CPU has it, else
-// lowered to pairs of two-double operations. Never passed by value (that would change the ABI
-// between the two builds): accessed in place through the unaligned, aliasing variant (a memcpy
-// through a stack copy costs a store-forwarding stall per load).
-typedef double V4 __attribute__((vector_size(32)));
-typedef double V4u __attribute__((vector_size(32), aligned(8), may_alias));
+// Two and four doubles (the latter lowered to pairs of two-double operations where AVX2 is not
+// available), accessed in place through unaligned, aliasing types. Never passed by value: that
+// would change the ABI between the two builds of a CAIRN_WIDE_KERNEL.
 typedef double V2u __attribute__((vector_size(16), aligned(8), may_alias));
+typedef double V4u __attribute__((vector_size(32), aligned(8), may_alias));
 // By lane count (as a template argument a typedef would lose its attributes).
 template <int Lanes> struct Unaligned;
 template <> struct Unaligned<1> { using type = double; };
@@ -32,7 +19,7 @@ template <> struct Unaligned<2> { using type = V2u; };
 template <> struct Unaligned<4> { using type = V4u; };
 
 // A kernel compiled for AVX2 and for the baseline ISA, chosen once at load time by the CPU: the
-// result on one machine does not depend on the path (no FMA, the same operations lane by lane).
+// result does not depend on the path taken (no FMA: the same operations, lane by lane).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define CAIRN_WIDE_KERNEL __attribute__((target_clones("avx2", "default")))
 #else
