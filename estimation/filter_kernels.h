@@ -64,10 +64,16 @@ template <int Lanes, int Inner, int K, Mode kMode>
 template <int Inner, int K, Mode kMode>
 CAIRN_WIDE_KERNEL static void MulRows(double* R, int ldr, const double* A, int lda, int rows, const double* B,
                                       int ldb) {
+  // B copied to a local, packed table: R is accessed through an aliasing type, so B's elements
+  // would otherwise be reloaded through their strided addresses (kept in spilled registers).
+  double b[Inner * K];
+  for (int k = 0; k < K; ++k) {
+    for (int c = 0; c < Inner; ++c) b[c + k * Inner] = B[c + k * ldb];
+  }
   int i = 0;
-  for (; i + 4 <= rows; i += 4) detail::MulRowsAt<4, Inner, K, kMode>(R, ldr, A, lda, B, ldb, i);
-  for (; i + 2 <= rows; i += 2) detail::MulRowsAt<2, Inner, K, kMode>(R, ldr, A, lda, B, ldb, i);
-  for (; i < rows; ++i) detail::MulRowsAt<1, Inner, K, kMode>(R, ldr, A, lda, B, ldb, i);
+  for (; i + 4 <= rows; i += 4) detail::MulRowsAt<4, Inner, K, kMode>(R, ldr, A, lda, b, Inner, i);
+  for (; i + 2 <= rows; i += 2) detail::MulRowsAt<2, Inner, K, kMode>(R, ldr, A, lda, b, Inner, i);
+  for (; i < rows; ++i) detail::MulRowsAt<1, Inner, K, kMode>(R, ldr, A, lda, b, Inner, i);
 }
 
 // The same with K split into chunks of at most 6 columns (keeps the accumulators in registers).
