@@ -39,7 +39,8 @@ struct CloneSlot {
   Timestamp last_used;
 };
 
-struct FilterState {
+// Everything but the full covariance matrix (what a replay snapshot copies as is).
+struct FilterStateHead {
   Timestamp time;
   // IMU pose and velocity in the current local frame (gravity along -z).
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
@@ -52,7 +53,14 @@ struct FilterState {
   Eigen::Vector3d accel = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyro = Eigen::Vector3d::Zero();
   std::array<CloneSlot, kMaxClones> clones{};
-  StateCovariance P = StateCovariance::Zero();
+  // The deferred parts of the covariance P (see FilterState).
+  Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor> phi =
+      Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor>::Identity();
+  std::array<bool, kMaxClones> cross_current{};
+  bool cross_pending = false;
+};
+
+struct FilterState : FilterStateHead {
   // Parts of P are kept deferred so that the work per IMU sample and per core-only update does
   // not grow with the number of clones. While cross_pending is set:
   //  - the core block P[0:15, 0:15] is current;
@@ -61,14 +69,18 @@ struct FilterState {
   //    is B_j phi^T: propagation and core-only updates (wheel, position) change the core-clone
   //    cross-covariance by left-multiplication, which is accumulated in phi;
   //  - of the clone-clone block, the 6x6 blocks on and below the block diagonal are current;
-  //  - the top-right block and the clone-clone blocks above the diagonal are stale.
-  // Free slots have all-zero rows and columns. MaterializeCovariance makes P complete.
-  Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor> phi =
-      Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor>::Identity();
-  std::array<bool, kMaxClones> cross_current{};
-  bool cross_pending = false;
+  //  - the top-right block and the clone-clone blocks above the diagonal are stale and held at
+  //    zero (MarkDeferred), so that a state restored from a packed snapshot (which keeps only the
+  //    current parts) is bit-identical to the one that was saved.
+  // While cross_pending is clear, P is complete and exactly symmetric, phi is the identity and no
+  // cross block is flagged current. Free slots have all-zero rows and columns.
+  // MaterializeCovariance makes P complete.
+  StateCovariance P = StateCovariance::Zero();
 };
 
+// Sets cross_pending, zeroing the stale parts of P if it was complete: every change that leaves P
+// in the deferred representation ends with it.
+void MarkDeferred(FilterState& s);
 // Makes every cross block current (applies phi, which becomes the identity).
 void MaterializeCross(FilterState& s);
 // Makes P complete and symmetric.
@@ -76,5 +88,20 @@ void MaterializeCovariance(FilterState& s);
 // The true covariance of a clone with the core state (6x15), and the true clone-clone block (i, j).
 Eigen::Matrix<double, 6, kCoreDim> CrossRows(const FilterState& s, int slot);
 Matrix6d CloneBlock(const FilterState& s, int i, int j);
+
+// The current parts of P (above): the core columns in full and, of each clone column block, the
+// rows from its diagonal block down, about 55 % of P. Column-major runs, so packing is a few
+// contiguous copies.
+constexpr int PackedCovarianceSize() {
+  int n = kCoreDim * kStateDim;
+  for (int j = 0; j < kMaxClones; ++j) n += 6 * (kStateDim - CloneIndex(j));
+  return n;
+}
+using PackedCovariance = std::array<double, PackedCovarianceSize()>;
+void PackCovariance(const StateCovariance& P, PackedCovariance& out);
+// Restores P from a packing of a state with the given cross_pending (s.cross_pending is the
+// state's current one, s.P's stale parts are zero if it is set). The result is bit-identical to
+// the packed P: stale parts become zero, a complete P is completed from its lower part.
+void UnpackCovariance(const PackedCovariance& in, bool packed_pending, FilterState& s);
 
 }  // namespace cairn

@@ -106,7 +106,7 @@ UpdateOutcome CoreUpdate(FilterState& s, const Eigen::Matrix<double, M, kCoreDim
                                                      kCloneDims, 6, W_t.data(), M);
   }
   SubtractCloneOuter<M>(s, V);
-  s.cross_pending = true;
+  MarkDeferred(s);
   InjectError(s, dx);
   return UpdateOutcome::kApplied;
 }
@@ -209,7 +209,7 @@ UpdateOutcome ApplyRelativePoseUpdate(FilterState& s, const RelativePoseMeasurem
   kernels::MulRowsWide<6, kCoreDim, kernels::kSub>(&s.P(kCoreDim, 0), kStateDim, Wx.data(), kCloneDims, kCloneDims,
                                                    Wc_t.data(), 6);
   SubtractCloneOuter<6>(s, Wx);
-  s.cross_pending = true;
+  MarkDeferred(s);
   InjectError(s, dx);
   return UpdateOutcome::kApplied;
 }

@@ -21,12 +21,14 @@ struct Transition {
 };
 
 // M <- M Phi^T for a column-major matrix M with `Rows` rows and 15 columns (leading dimension
-// ld): each row is one error vector, so the work is a few axpy over contiguous columns, done two
-// rows at a time. Applied to the transpose of a matrix, this is the left-multiplication Phi X.
-template <typename T>
-inline void TransitionRow(const Transition& f, T* const* col, int i) {
-  using kernels::Load;
-  (void)i;
+// ld): each row is one error vector, so the work is a few axpy over contiguous columns, done for
+// `Lanes` rows (from row i) at a time, in place. Applied to the transpose of a matrix, this is the
+// left-multiplication Phi X.
+template <int Lanes>
+[[gnu::always_inline]] inline void TransitionRow(const Transition& f, double* m, int ld, int i) {
+  using T = typename kernels::Unaligned<Lanes>::type;
+  T* col[kCoreDim];
+  for (int c = 0; c < kCoreDim; ++c) col[c] = reinterpret_cast<T*>(m + static_cast<ptrdiff_t>(c) * ld + i);
   const double a0 = f.a.x(), a1 = f.a.y(), a2 = f.a.z();
   const Eigen::Matrix3d& F = f.Fva;
   const Eigen::Matrix3d& R = f.Ftt;
@@ -51,23 +53,16 @@ inline void TransitionRow(const Transition& f, T* const* col, int i) {
   *col[5] = *col[5] + d2;
 }
 
+// Four rows at a time (the AVX2 build keeps them in one register each), then two, then one.
 template <int Rows>
-void ApplyTransitionT(const Transition& f, double* m, int ld) {
-  using kernels::V2;
+CAIRN_WIDE_KERNEL void ApplyTransitionT(const Transition& f, double* m, int ld) {
   int i = 0;
-  for (; i + 2 <= Rows; i += 2) {
-    V2 v[kCoreDim];
-    for (int c = 0; c < kCoreDim; ++c) v[c] = kernels::Load(m + static_cast<ptrdiff_t>(c) * ld + i);
-    V2* col[kCoreDim];
-    for (int c = 0; c < kCoreDim; ++c) col[c] = &v[c];
-    TransitionRow<V2>(f, col, i);
-    for (int c = 0; c < 9; ++c) kernels::Store(m + static_cast<ptrdiff_t>(c) * ld + i, v[c]);
+  for (; i + 4 <= Rows; i += 4) TransitionRow<4>(f, m, ld, i);
+  if constexpr (Rows % 4 >= 2) {
+    TransitionRow<2>(f, m, ld, i);
+    i += 2;
   }
-  if constexpr (Rows % 2 == 1) {
-    double* col[kCoreDim];
-    for (int c = 0; c < kCoreDim; ++c) col[c] = m + static_cast<ptrdiff_t>(c) * ld + i;
-    TransitionRow<double>(f, col, i);
-  }
+  if constexpr (Rows % 2 == 1) TransitionRow<1>(f, m, ld, i);
 }
 
 // Jr(phi) from the rotation's half-angle sine and cosine (no further trigonometry).
@@ -124,28 +119,33 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   f.Ftg = -dt * RightJacobianFromHalfAngle(phi, s_half, c_half);
 
   // P_core <- Phi P_core Phi^T + Q: with P_core symmetric, Y^T = P_core Phi^T and then
-  // Phi P_core Phi^T = Y Phi^T.
-  Eigen::Matrix<double, kCoreDim, kCoreDim> Yt = s.P.topLeftCorner<kCoreDim, kCoreDim>();
-  ApplyTransitionT<kCoreDim>(f, Yt.data(), kCoreDim);
-  Eigen::Matrix<double, kCoreDim, kCoreDim> core = Yt.transpose();
-  // Only rows p, v, theta are needed (the bias rows follow by symmetry from the bias columns,
-  // which Phi^T leaves unchanged).
-  ApplyTransitionT<9>(f, core.data(), kCoreDim);
-  core.bottomRows<6>() = core.rightCols<6>().transpose().eval();
+  // Phi P_core Phi^T = Y Phi^T. Phi leaves the bias rows alone, so Y^T is formed in place (its
+  // bias columns are P's) and only the p, v, theta rows of Y Phi^T are computed; the bias rows
+  // follow by symmetry and the bias block only gains its noise (P_core is kept exactly
+  // symmetric).
+  double* const pc = s.P.data();
+  ApplyTransitionT<kCoreDim>(f, pc, kStateDim);
+  Eigen::Matrix<double, 9, kCoreDim> top;  // rows p, v, theta of Y, then of Y Phi^T
+  for (int c = 0; c < kCoreDim; ++c) {
+    for (int i = 0; i < 9; ++i) top(i, c) = pc[i * kStateDim + c];
+  }
+  ApplyTransitionT<9>(f, top.data(), 9);
 
   const double qa = noise_.accel_noise_density * noise_.accel_noise_density;
   const double qg = noise_.gyro_noise_density * noise_.gyro_noise_density;
   const double qba = noise_.accel_random_walk * noise_.accel_random_walk;
   const double qbg = noise_.gyro_random_walk * noise_.gyro_random_walk;
   const double dt2 = dt * dt;
-  core.block<3, 3>(kP, kP).diagonal().array() += qa * dt2 * dt / 3.0;
-  core.block<3, 3>(kP, kV).diagonal().array() += qa * dt2 / 2.0;
-  core.block<3, 3>(kV, kP).diagonal().array() += qa * dt2 / 2.0;
-  core.block<3, 3>(kV, kV).diagonal().array() += qa * dt;
-  core.block<3, 3>(kTheta, kTheta).diagonal().array() += qg * dt;
-  core.block<3, 3>(kBa, kBa).diagonal().array() += qba * dt;
-  core.block<3, 3>(kBg, kBg).diagonal().array() += qbg * dt;
-  s.P.topLeftCorner<kCoreDim, kCoreDim>() = 0.5 * (core + core.transpose());
+  top.block<3, 3>(kP, kP).diagonal().array() += qa * dt2 * dt / 3.0;
+  top.block<3, 3>(kP, kV).diagonal().array() += qa * dt2 / 2.0;
+  top.block<3, 3>(kV, kP).diagonal().array() += qa * dt2 / 2.0;
+  top.block<3, 3>(kV, kV).diagonal().array() += qa * dt;
+  top.block<3, 3>(kTheta, kTheta).diagonal().array() += qg * dt;
+  s.P.topLeftCorner<9, 9>() = 0.5 * (top.leftCols<9>() + top.leftCols<9>().transpose());
+  s.P.block<9, 6>(0, 9) = top.rightCols<6>();
+  s.P.block<6, 9>(9, 0) = top.rightCols<6>().transpose();
+  s.P.block<3, 3>(kBa, kBa).diagonal().array() += qba * dt;
+  s.P.block<3, 3>(kBg, kBg).diagonal().array() += qbg * dt;
 
   // Cross-covariance with the clones: X <- Phi X, deferred in phi (phi <- Phi phi; phi is
   // row-major, so its storage is phi^T) except for the clones whose cross block is kept current
@@ -156,7 +156,7 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
     if (s.clones[u].id == kNoClone || !s.cross_current[u]) continue;
     ApplyTransitionT<6>(f, &s.P(CloneIndex(j), 0), kStateDim);
   }
-  s.cross_pending = true;
+  MarkDeferred(s);
 
   s.time = t1;
   s.accel = accel1;

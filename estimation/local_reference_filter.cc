@@ -58,6 +58,7 @@ LocalReferenceFilter::LocalReferenceFilter(const FilterOptions& options, const I
     : options_(options),
       calibration_(imu),
       wheels_(wheels),
+      T_imu_body_(imu.T_body_imu.inverse()),
       propagator_(ImuNoise::FromCalibration(imu), options.gravity),
       initializer_(options),
       imu_(static_cast<size_t>(std::clamp<int64_t>(options.imu_buffer, 16, kMaxImuBuffer))),
@@ -239,7 +240,7 @@ FilterResult LocalReferenceFilter::Submit(Event e) {
   if ((state_.time - e.time).seconds() <= options_.max_update_delay) {
     for (uint64_t j = snap_end_; j > snap_begin_; --j) {
       const Snapshot& sn = snapshots_[(j - 1) % snapshots_.size()];
-      if (sn.event_seq <= pos && sn.state.time <= e.time) {
+      if (sn.event_seq <= pos && sn.head.time <= e.time) {
         if (sn.event_seq >= ev_begin_ && sn.imu_seq >= imu_begin_) found = j - 1;
         break;
       }
@@ -257,7 +258,8 @@ FilterResult LocalReferenceFilter::Submit(Event e) {
 
   Insert(pos, e);
   const Snapshot& sn = snapshots_[found % snapshots_.size()];
-  state_ = sn.state;
+  UnpackCovariance(sn.P, sn.head.cross_pending, state_);  // before the head: uses the live flag
+  static_cast<FilterStateHead&>(state_) = sn.head;
   ev_next_ = sn.event_seq;
   snap_end_ = found + 1;
   replaying_ = true;
@@ -400,7 +402,7 @@ void LocalReferenceFilter::AddClone(CloneId id) {
   d.bottomRightCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kTheta);
   state_.P.block<6, 6>(ic, ic) = d;
   state_.cross_current[static_cast<size_t>(slot)] = true;
-  state_.cross_pending = true;
+  MarkDeferred(state_);
 
   CloneSlot& c = state_.clones[static_cast<size_t>(slot)];
   c.id = id;
@@ -417,7 +419,8 @@ void LocalReferenceFilter::PushSnapshot(uint64_t imu_seq) {
     ev_begin_ = std::max(ev_begin_, snapshots_[snap_begin_ % snapshots_.size()].event_seq);
   }
   Snapshot& sn = snapshots_[snap_end_ % snapshots_.size()];
-  sn.state = state_;
+  sn.head = static_cast<const FilterStateHead&>(state_);
+  PackCovariance(state_.P, sn.P);
   sn.imu_seq = imu_seq;
   sn.event_seq = ev_next_;
   ++snap_end_;
@@ -436,7 +439,7 @@ void LocalReferenceFilter::WriteHistory(uint64_t k) {
   h.T_frame_body = Eigen::Isometry3d::Identity();
   h.T_frame_body.linear() = state_.q.toRotationMatrix();
   h.T_frame_body.translation() = state_.p;
-  h.T_frame_body = h.T_frame_body * calibration_.T_body_imu.inverse();
+  h.T_frame_body = h.T_frame_body * T_imu_body_;
   h.covariance.topLeftCorner<3, 3>() = state_.P.block<3, 3>(kP, kP);
   h.covariance.topRightCorner<3, 3>() = state_.P.block<3, 3>(kP, kTheta);
   h.covariance.bottomLeftCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kP);

@@ -168,8 +168,11 @@ class LocalReferenceFilter {
     Eigen::Quaterniond rot = Eigen::Quaterniond::Identity();
     Matrix6d cov = Matrix6d::Zero();
   };
+  // The state right after a clone. P is kept packed (its current parts only): a replay writes
+  // one snapshot per clone it passes and restores one, and the full matrix is 60 KB.
   struct Snapshot {
-    FilterState state;
+    FilterStateHead head;
+    PackedCovariance P{};
     uint64_t imu_seq = 0;    // first IMU sample not yet fully integrated
     uint64_t event_seq = 0;  // first event not yet processed
   };
@@ -193,6 +196,7 @@ class LocalReferenceFilter {
   FilterOptions options_;
   ImuCalibration calibration_;
   WheelCalibration wheels_;
+  Eigen::Isometry3d T_imu_body_;  // inverse of calibration_.T_body_imu, for the IMU-rate history
   ImuPropagator propagator_;
   StaticInitializer initializer_;
   FilterState state_;

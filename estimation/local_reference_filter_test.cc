@@ -206,6 +206,44 @@ TEST(LocalReferenceFilterTest, DelayedUpdatesAroundFrameSwitchesAreDeterministic
   EXPECT_EQ(c.frame_switches, 5u);
 }
 
+// Replay snapshots keep P packed (its current parts only): restoring must reproduce the saved
+// matrix bit for bit, from a deferred and from a complete covariance, into either kind of state.
+TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
+  ScenarioOptions s;
+  s.duration = 2.0;
+  s.update_delay = 0.25;
+  s.wheel_rate = 20.0;
+  FilterOptions o;
+  o.wheel_enabled = true;
+  FilterScenario a(s, o);
+  a.Run();
+  const FilterState deferred = a.filter().state();
+  ASSERT_TRUE(deferred.cross_pending);
+  // The stale parts of a deferred P are held at zero.
+  constexpr int kCloneDims = kStateDim - kCoreDim;
+  EXPECT_EQ((deferred.P.topRightCorner<kCoreDim, kCloneDims>().cwiseAbs().maxCoeff()), 0.0);
+  for (int j = 1; j < kMaxClones; ++j) {
+    EXPECT_EQ(deferred.P.block(kCoreDim, CloneIndex(j), 6 * j, 6).cwiseAbs().maxCoeff(), 0.0) << j;
+  }
+  FilterState complete_state = deferred;
+  MaterializeCovariance(complete_state);
+  const FilterState& complete = complete_state;
+  ASSERT_FALSE(complete.cross_pending);
+  ASSERT_GT((complete.P - deferred.P).cwiseAbs().maxCoeff(), 0.0);
+
+  PackedCovariance packed;
+  for (const FilterState* saved : {&deferred, &complete}) {
+    PackCovariance(saved->P, packed);
+    for (const FilterState* target : {&deferred, &complete}) {
+      FilterState t = *target;
+      t.P(kCoreDim, kCoreDim) += 1.0;  // something to overwrite
+      UnpackCovariance(packed, saved->cross_pending, t);
+      EXPECT_TRUE((t.P.array() == saved->P.array()).all())
+          << "saved " << saved->cross_pending << " into " << target->cross_pending;
+    }
+  }
+}
+
 TEST(LocalReferenceFilterTest, FrameSwitchKeepsPoseAndResetsPositionAndYaw) {
   ScenarioOptions s;
   s.duration = 4.0;

@@ -1,15 +1,21 @@
 // cairn bench filter [--samples N] [--delay S] [--switch-period S] [--wheel-rate HZ]
-// [--nonholonomic]: wall time per IMU propagation, delayed relative-pose update, wheel update and
+// [--nonholonomic] [--no-realtime]: wall time per IMU propagation, delayed relative-pose update, wheel update and
 // frame switch of the local reference filter on a simulated run (200 Hz IMU, 20 Hz clones and
 // relative poses, 20 Hz wheel odometry by default; the rover profile's CAN odometry runs at
 // 100 Hz with the non-holonomic constraint: --wheel-rate 100 --nonholonomic).
+// The measured loop runs as the daemon's filter thread does: SCHED_FIFO at the estimation
+// executor's priority with the process memory locked (--no-realtime to skip); where the system
+// refuses, it runs normally and the JSON says why.
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "daemon/executor.h"
 #include "estimation/filter_scenario.h"
 #include "tools/commands.h"
 
@@ -40,7 +46,7 @@ void PrintStats(const Timings& t, bool last) {
 int RunBenchFilter(const CommandArgs& args) {
   long samples = 120000;
   double delay = 0.25, switch_period = 10.0, wheel_rate = 20.0;
-  bool nonholonomic = false;
+  bool nonholonomic = false, realtime = true;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has_value = i + 1 < args.args.size();
@@ -54,10 +60,12 @@ int RunBenchFilter(const CommandArgs& args) {
       wheel_rate = std::strtod(args.args[++i], nullptr);
     } else if (a == "--nonholonomic") {
       nonholonomic = true;
+    } else if (a == "--no-realtime") {
+      realtime = false;
     } else {
       std::fprintf(stderr,
                    "usage: cairn bench filter [--samples N] [--delay S] [--switch-period S] [--wheel-rate HZ] "
-                   "[--nonholonomic]\n");
+                   "[--nonholonomic] [--no-realtime]\n");
       return 2;
     }
   }
@@ -79,12 +87,35 @@ int RunBenchFilter(const CommandArgs& args) {
   std::vector<Timings> t = {{"imu_propagation", {}}, {"relative_pose_update", {}},
                             {"wheel_update", {}}, {"frame_switch", {}}};
   for (auto& x : t) x.us.reserve(static_cast<size_t>(samples));
-  while (scenario.Step([&](int kind, double seconds) { t[static_cast<size_t>(kind)].us.push_back(seconds * 1e6); })) {
-  }
+  // Locked after everything is allocated, so the scenario and the timing buffers are resident.
+  std::string lock_note;
+  const bool locked = realtime && Executor::LockProcessMemory(&lock_note);
+  ExecutorOptions eo;
+  eo.realtime = realtime;
+  eo.priority = 80;  // the estimation executor's priority in configs/
+  Executor thread("bench-filter", eo);
+  thread.Start([&](std::stop_token) {
+    // The daemon's filter thread waits for its data; this loop would not, and a SCHED_FIFO thread
+    // that stays busy for 950 ms of a second is stopped by the kernel's RT throttling for the
+    // rest (a 50 ms "latency"). So it pauses 2 ms after every 20 ms of work, between steps.
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point busy_since = Clock::now();
+    while (scenario.Step([&](int kind, double seconds) { t[static_cast<size_t>(kind)].us.push_back(seconds * 1e6); })) {
+      if (Clock::now() - busy_since > std::chrono::milliseconds(20)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        busy_since = Clock::now();
+      }
+    }
+  });
+  thread.Join();
+  std::string rt_note = thread.report().affinity_note;
+  if (realtime && !locked) rt_note += (rt_note.empty() ? "" : "; ") + lock_note;
   const FilterCounters& c = scenario.filter().counters();
   std::printf("{\n  \"benchmark\": \"filter\",\n  \"imu_rate_hz\": 200, \"update_rate_hz\": 20, "
               "\"update_delay_s\": %.3f, \"max_clones\": %d, \"wheel_rate_hz\": %.1f, \"nonholonomic\": %s,\n",
               delay, kMaxClones, wheel_rate, nonholonomic ? "true" : "false");
+  std::printf("  \"policy\": \"%s\", \"priority\": %d, \"memory_locked\": %s, \"realtime_note\": \"%s\",\n",
+              thread.report().policy.c_str(), thread.report().priority, locked ? "true" : "false", rt_note.c_str());
   std::printf("  \"imu_samples\": %zu, \"updates_applied\": %lu, \"updates_rejected\": %lu, "
               "\"replays\": %lu, \"replayed_imu_samples\": %lu,\n",
               t[0].us.size(), static_cast<unsigned long>(c.updates_applied),
