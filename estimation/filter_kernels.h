@@ -20,7 +20,10 @@ template <> struct Unaligned<4> { using type = V4u; };
 
 // A kernel compiled for AVX2 and for the baseline ISA, chosen once at load time by the CPU: the
 // result does not depend on the path taken (no FMA: the same operations, lane by lane).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// ThreadSanitizer builds go without: the loader runs the resolvers before the sanitizer's runtime
+// is set up, and the instrumented resolvers crash (as in drivers/simulator/simd_clones.h).
+#if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_THREAD__)
 #define CAIRN_WIDE_KERNEL __attribute__((target_clones("avx2", "default")))
 #else
 #define CAIRN_WIDE_KERNEL
