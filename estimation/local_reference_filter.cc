@@ -300,12 +300,11 @@ FilterResult LocalReferenceFilter::ProcessEvent(Event& e) {
       return r;
     }
     case EventKind::kWheel: {
-      const Eigen::Isometry3d T_imu_body = calibration_.T_body_imu.inverse();
       Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
       cov.topLeftCorner<2, 2>() = e.cov.topLeftCorner<2, 2>();
       cov(2, 2) = options_.nonholonomic_sigma * options_.nonholonomic_sigma;
-      return FromOutcome(ApplyBodyVelocityUpdate(state_, T_imu_body.linear(),
-                                                 T_imu_body.translation(), e.vec, cov,
+      return FromOutcome(ApplyBodyVelocityUpdate(state_, T_imu_body_.linear(),
+                                                 T_imu_body_.translation(), e.vec, cov,
                                                  options_.nonholonomic ? 3 : 2));
     }
     case EventKind::kPosition:
@@ -551,14 +550,7 @@ FilterResult LocalReferenceFilter::ApplyRelativePose(CloneId keyframe, CloneId c
 
 FilterResult LocalReferenceFilter::ApplyWheelOdometry(const BodyVelocity& velocity) {
   if (!initialized_) {
-    // Turning wheels: the IMU's quiet window is not a still one (see StaticInitializer). Encoder
-    // noise must not count as motion: the speed must also be far outside its covariance
-    // (chi-square, 2 degrees of freedom, 99.97 %).
-    if (options_.wheel_enabled && velocity.v_xy.allFinite() && CovarianceOk(velocity.covariance) &&
-        velocity.v_xy.norm() > options_.init_max_wheel_speed &&
-        velocity.v_xy.dot(velocity.covariance.inverse() * velocity.v_xy) > 16.0) {
-      initializer_.MotionSeen();
-    }
+    if (options_.wheel_enabled) initializer_.AddBodyVelocity(velocity.v_xy, velocity.covariance);
     return FilterResult::kNotInitialized;
   }
   FilterResult r = FilterResult::kApplied;
@@ -610,7 +602,7 @@ FrameSwitchResult LocalReferenceFilter::RequestFrameSwitch() {
   if (!initialized_) return out;
   out.time = state_.time;
   out.old_frame_id = frame_id_;
-  out.transform = SwitchFrame(state_, calibration_.T_body_imu.inverse(), scratch_a_, scratch_b_);
+  out.transform = SwitchFrame(state_, T_imu_body_, scratch_a_, scratch_b_);
   ++frame_id_;
   out.new_frame_id = frame_id_;
   out.result = FilterResult::kApplied;
@@ -627,7 +619,7 @@ FilterOutput LocalReferenceFilter::Output() const {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = state_.q.toRotationMatrix();
   T.translation() = state_.p;
-  o.T_frame_body = T * calibration_.T_body_imu.inverse();
+  o.T_frame_body = T * T_imu_body_;
   o.v_frame_imu = state_.v;
   o.accel_bias = state_.ba;
   o.gyro_bias = state_.bg;

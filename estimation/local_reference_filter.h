@@ -196,7 +196,7 @@ class LocalReferenceFilter {
   FilterOptions options_;
   ImuCalibration calibration_;
   WheelCalibration wheels_;
-  Eigen::Isometry3d T_imu_body_;  // inverse of calibration_.T_body_imu, for the IMU-rate history
+  Eigen::Isometry3d T_imu_body_;  // inverse of calibration_.T_body_imu, computed once
   ImuPropagator propagator_;
   StaticInitializer initializer_;
   FilterState state_;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Cholesky>
+
 namespace cairn {
 
 void StaticInitializer::Reset() {
@@ -13,7 +15,10 @@ void StaticInitializer::Reset() {
   block_gyro_.setZero();
 }
 
-void StaticInitializer::MotionSeen() {
+void StaticInitializer::AddBodyVelocity(const Eigen::Vector2d& v_xy, const Eigen::Matrix2d& covariance) {
+  if (!v_xy.allFinite() || v_xy.norm() <= options_.init_max_wheel_speed) return;
+  const Eigen::LLT<Eigen::Matrix2d> llt(covariance);
+  if (llt.info() != Eigen::Success || !(v_xy.dot(llt.solve(v_xy)) > 16.0)) return;
   if (count_ > 0) ++restarts_;
   Reset();
 }

@@ -26,8 +26,10 @@ class StaticInitializer {
 
   // Returns true when the sample completes a still window.
   bool Add(const ImuSample& sample);
-  // Another sensor (the wheels) saw motion: the window restarts.
-  void MotionSeen();
+  // Body x/y velocity from the wheels, with covariance: a speed above init_max_wheel_speed that
+  // is also far outside the encoder noise (chi-square, 2 degrees of freedom, 99.97 %) is motion,
+  // and the window restarts.
+  void AddBodyVelocity(const Eigen::Vector2d& v_xy, const Eigen::Matrix2d& covariance);
   void Reset();
 
   const Eigen::Vector3d& mean_accel() const { return mean_accel_; }
