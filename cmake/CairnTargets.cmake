@@ -12,7 +12,7 @@ function(cairn_warnings target)
     # system-header code, and reports the same family of false positives (bug 105329) as
     # -Warray-bounds inside std::string's operator+. Sanitizer builds only; ASan checks bounds.
     if(CAIRN_PCH)
-      target_compile_options(${target} PRIVATE -Wno-array-bounds -Wno-stringop-overflow)
+      target_compile_options(${target} PRIVATE -Wno-array-bounds -Wno-stringop-overflow -Wno-stringop-overread)
     endif()
   endif()
 endfunction()

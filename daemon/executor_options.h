@@ -43,6 +43,8 @@ struct ExecutorsOptions {
   ExecutorOptions mapping;
   ExecutorOptions telemetry;   // recording and the live stream
   ExecutorOptions graph;       // the SLAM graph's online optimization (low priority)
+  // The graph's full solves after loop closures, live only (replays solve inline, deterministic).
+  ExecutorOptions graph_full_solve;
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
@@ -51,6 +53,7 @@ struct ExecutorsOptions {
     v.Section("mapping", mapping);
     v.Section("telemetry", telemetry);
     v.Section("graph", graph);
+    v.Section("graph_full_solve", graph_full_solve);
   }
 };
 

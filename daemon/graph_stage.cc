@@ -204,14 +204,8 @@ PoseGraph GraphStage::ExportPoseGraph() const {
   }
   g.set_has_initial_estimate(true);
   for (const SlamFactor& f : graph_.factors()) {
-    if (IsUnary(f.kind)) continue;  // the prior: g2o readers take the first vertex as the gauge
-    PoseGraphEdge edge;
-    edge.from = f.a;
-    edge.to = f.b;
-    edge.T_from_to = f.z;
-    edge.information = f.information;
-    PoseGraph::SetIsotropicWeights(edge);
-    g.AddEdge(edge);
+    // Not the prior: g2o readers take the first vertex as the gauge.
+    if (!IsUnary(f.kind)) g.AddEdge(EdgeOfFactor(f));
   }
   return g;
 }

@@ -61,8 +61,10 @@ class GraphStage {
  public:
   GraphStage(const GraphStageOptions& options, bool deterministic);
 
+  // Full solves after loop closures go through `runner` (live); without one they run inline.
+  void SetBackgroundRunner(SlamGraph::BackgroundRunner runner) { graph_.SetBackgroundRunner(std::move(runner)); }
   void OnInput(const GraphInput& input);
-  // End of the run: optimizes to convergence.
+  // End of the run: waits for a running full solve, then optimizes to convergence.
   void Finish();
 
   GraphStageReport report() const;

@@ -36,6 +36,7 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       vo_("vo", executors.vo),
       mapping_exec_("mapping", executors.mapping),
       graph_exec_("graph", executors.graph),
+      graph_full_solve_exec_("graph_full_solve", executors.graph_full_solve),
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
@@ -80,6 +81,9 @@ Status Pipeline::EnableGraph(const GraphStageOptions& options) {
   if (started_) return FailedPreconditionError("EnableGraph() after Start()");
   if (!estimation_) return FailedPreconditionError("the graph needs the estimation chain (vo.enabled)");
   graph_ = std::make_unique<GraphStage>(options, deterministic_);
+  // Live, full solves after loop closures run on their own executor; replays solve them inline so
+  // that the result does not depend on thread timing.
+  if (!deterministic_) graph_->SetBackgroundRunner(graph_worker_.Runner());
   estimation_->PublishToGraph(&graph_queue_);
   return Status::Ok();
 }
@@ -104,6 +108,9 @@ void Pipeline::Start() {
   if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
   if (mapping_) mapping_exec_.Start([this](std::stop_token stop) { MappingLoop(stop); });
   if (graph_) graph_exec_.Start([this](std::stop_token stop) { GraphLoop(stop); });
+  if (graph_ && !deterministic_) {
+    graph_full_solve_exec_.Start([this](std::stop_token stop) { graph_worker_.Run(stop); });
+  }
 }
 
 void Pipeline::StopAndDrain() {
@@ -134,7 +141,9 @@ void Pipeline::StopAndDrain() {
     graph_exec_.RequestStop();
     graph_signal_.Notify();
     graph_exec_.Join();
-    graph_->Finish();
+    graph_->Finish();  // waits for a running full solve, so its worker stops after it
+    graph_full_solve_exec_.RequestStop();
+    graph_full_solve_exec_.Join();
   }
   // What the filter emitted last is mapped too; the open submap is finished and the map written.
   if (mapping_) {
@@ -478,6 +487,7 @@ std::vector<ExecutorReport> Pipeline::executor_reports() const {
   if (estimation_) out.push_back(vo_.report());
   if (mapping_) out.push_back(mapping_exec_.report());
   if (graph_) out.push_back(graph_exec_.report());
+  if (graph_ && !deterministic_) out.push_back(graph_full_solve_exec_.report());
   return out;
 }
 

@@ -24,6 +24,7 @@
 #include "daemon/spsc_queue.h"
 #include "daemon/stereo_rectify_stage.h"
 #include "daemon/vo_stage.h"
+#include "estimation/graph_worker.h"
 #include "hal/calibration.h"
 #include "hal/sensor_sink.h"
 #include "mapping/frame_switch_requester_interface.h"
@@ -202,6 +203,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   Executor vo_;
   Executor mapping_exec_;
   Executor graph_exec_;
+  GraphWorker graph_worker_{false};  // runs on graph_full_solve_exec_
+  Executor graph_full_solve_exec_;
 
   // Owned by the estimation thread until joined.
   SensorStreamStats imu_stats_;

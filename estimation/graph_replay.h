@@ -14,12 +14,19 @@ namespace cairn {
 struct GraphReplayResult {
   std::vector<double> step_seconds;  // one per step that added factors
   int reinitializations = 0;
+  int full_solves = 0;         // merged into the online estimate
+  int stale_full_solves = 0;   // dropped: the graph's structure changed while they ran
+  // After the last step: waiting for the running full solve and merging it, as the robot's graph
+  // would a moment later.
+  double settle_seconds = 0.0;
   size_t unconnected = 0;
 };
 
 uint64_t SubmapKeyOfG2oId(uint64_t id);
 
-// Writes the online estimate back into `graph`'s vertices.
-Expected<GraphReplayResult> ReplayPoseGraph(PoseGraph& graph, SlamGraphOptions options);
+// Writes the online estimate back into `graph`'s vertices. With a runner, full solves run in the
+// background (the step times are the online thread's); without, inline.
+Expected<GraphReplayResult> ReplayPoseGraph(PoseGraph& graph, SlamGraphOptions options,
+                                            SlamGraph::BackgroundRunner runner = {});
 
 }  // namespace cairn

@@ -1,5 +1,6 @@
 #pragma once
-// Ceres cost functors on 6-D poses. A pose parameter block is 7 doubles [tx ty tz qx qy qz qw]
+// Ceres cost functors on 6-D poses (the reference residuals; Create() gives the analytic cost
+// functions of pose_cost_functions.h, which tests check against AutoDiff() of these). A pose parameter block is 7 doubles [tx ty tz qx qy qz qw]
 // on PoseManifold() (R^3 x unit quaternion; the quaternion increment is applied on the left, so
 // covariances are in the world frame for rotation). Residual conventions:
 //  - Relative pose (geodesic): E = T_ij^-1 T_i^-1 T_j, r = sqrt(Info) [t(E); Log(R(E))]. Used for
@@ -14,6 +15,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include "estimation/pose_cost_functions.h"
 #include "estimation/pose_graph.h"
 
 namespace cairn {
@@ -65,8 +67,7 @@ struct RelativePoseResidual {
   }
 
   static ceres::CostFunction* Create(const Pose3& T_i_j, const Matrix6d& information) {
-    return new ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 7, 7>(
-        new RelativePoseResidual(T_i_j, information));
+    return new RelativePoseCost(T_i_j, information);
   }
 
   Eigen::Vector3d t_ij;
@@ -91,8 +92,7 @@ struct ChordalResidual {
   }
 
   static ceres::CostFunction* Create(const Pose3& T_i_j, double kappa, double tau) {
-    return new ceres::AutoDiffCostFunction<ChordalResidual, 12, 7, 7>(
-        new ChordalResidual(T_i_j, kappa, tau));
+    return new ChordalCost(T_i_j, kappa, tau);
   }
 
   Eigen::Matrix3d R_ij;
@@ -117,8 +117,7 @@ struct AbsolutePoseResidual {
   }
 
   static ceres::CostFunction* Create(const Pose3& Z, const Matrix6d& information) {
-    return new ceres::AutoDiffCostFunction<AbsolutePoseResidual, 6, 7>(
-        new AbsolutePoseResidual(Z, information));
+    return new AbsolutePoseCost(Z, information);
   }
 
   Eigen::Vector3d t;

@@ -60,6 +60,59 @@ void ExpectJacobiansMatchNumeric(const ceres::CostFunction& cost, std::vector<Po
   }
 }
 
+// Tangent-space Jacobians (through the manifold's PlusJacobian) and residuals of two cost
+// functions on the same poses.
+void ExpectSameCost(const ceres::CostFunction& analytic, const ceres::CostFunction& reference,
+                    const std::vector<Pose3>& poses) {
+  const auto manifold = MakePoseManifold();
+  const int m = analytic.num_residuals();
+  std::vector<std::vector<double>> blocks(poses.size(), std::vector<double>(7));
+  std::vector<const double*> params;
+  for (size_t b = 0; b < poses.size(); ++b) {
+    PoseToBlock(poses[b], blocks[b].data());
+    params.push_back(blocks[b].data());
+  }
+  auto eval = [&](const ceres::CostFunction& c, Eigen::VectorXd& r, std::vector<Eigen::MatrixXd>& J) {
+    std::vector<std::vector<double>> jac(poses.size(), std::vector<double>(static_cast<size_t>(7 * m)));
+    std::vector<double*> ptrs;
+    for (auto& j : jac) ptrs.push_back(j.data());
+    r.resize(m);
+    ASSERT_TRUE(c.Evaluate(params.data(), r.data(), ptrs.data()));
+    for (size_t b = 0; b < poses.size(); ++b) {
+      Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus;
+      manifold->PlusJacobian(blocks[b].data(), plus.data());
+      J.push_back(Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>>(jac[b].data(), m, 7) * plus);
+    }
+  };
+  Eigen::VectorXd ra, rr;
+  std::vector<Eigen::MatrixXd> Ja, Jr;
+  eval(analytic, ra, Ja);
+  eval(reference, rr, Jr);
+  EXPECT_LT((ra - rr).norm(), 1e-10 * (1 + rr.norm()));
+  for (size_t b = 0; b < poses.size(); ++b) EXPECT_LT((Ja[b] - Jr[b]).norm(), 1e-9 * (1 + Jr[b].norm())) << b;
+}
+
+TEST(PoseFactorsTest, AnalyticCostsEqualAutodiffOfTheReferenceFunctors) {
+  std::mt19937 rng(4);
+  for (int trial = 0; trial < 20; ++trial) {
+    // Large, small (the series branches) and near-pi rotation errors.
+    const double scale = trial % 3 == 0 ? 1.0 : trial % 3 == 1 ? 1e-7 : 0.0;
+    const Pose3 a = RandomPose(rng), z = RandomPose(rng, 0.5);
+    Pose3 b = a * z * RandomPose(rng, scale);
+    if (trial % 5 == 4) b = a * z * Pose3{Eigen::Vector3d(0.1, 0.2, 0.3), so3::ExpQuaternion(Eigen::Vector3d(0, 0, 3.1))};
+    const Matrix6d info = RandomInformation(rng);
+    std::unique_ptr<ceres::CostFunction> rel(RelativePoseResidual::Create(z, info));
+    ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 7, 7> rel_ref(new RelativePoseResidual(z, info));
+    ExpectSameCost(*rel, rel_ref, {a, b});
+    std::unique_ptr<ceres::CostFunction> chordal(ChordalResidual::Create(z, 3.0, 7.0));
+    ceres::AutoDiffCostFunction<ChordalResidual, 12, 7, 7> chordal_ref(new ChordalResidual(z, 3.0, 7.0));
+    ExpectSameCost(*chordal, chordal_ref, {a, b});
+    std::unique_ptr<ceres::CostFunction> abs(AbsolutePoseResidual::Create(a.Inverse() * b, info));
+    ceres::AutoDiffCostFunction<AbsolutePoseResidual, 6, 7> abs_ref(new AbsolutePoseResidual(a.Inverse() * b, info));
+    ExpectSameCost(*abs, abs_ref, {z});
+  }
+}
+
 TEST(PoseFactorsTest, RelativePoseResidualIsTheWeightedGeodesicError) {
   std::mt19937 rng(1);
   for (int trial = 0; trial < 10; ++trial) {

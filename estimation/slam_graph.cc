@@ -1,24 +1,15 @@
 #include "estimation/slam_graph.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include <ceres/ceres.h>
 
-#include "estimation/chordal_initializer.h"
+#include "estimation/graph_batch_job.h"
 #include "estimation/pose_factors.h"
 #include "estimation/so3.h"
 
 namespace cairn {
-
-bool IsUnary(FactorKind kind) {
-  return kind == FactorKind::kPrior || kind == FactorKind::kAbsolutePose ||
-         kind == FactorKind::kAbsolutePosition;
-}
-
-bool IsRobustFactor(FactorKind kind) {
-  return kind == FactorKind::kDetection || kind == FactorKind::kLandmark || kind == FactorKind::kMatch ||
-         kind == FactorKind::kAbsolutePose || kind == FactorKind::kAbsolutePosition;
-}
 
 namespace {
 
@@ -52,6 +43,16 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
     return InvalidArgumentError("information is not positive definite");
   }
   return Status::Ok();
+}
+
+SlamUpdateStats StatsOf(const GraphSolveResult& r, size_t variables, std::chrono::steady_clock::time_point start) {
+  SlamUpdateStats stats;
+  stats.solved = true;
+  stats.iterations = r.iterations;
+  stats.cost = r.cost;
+  stats.window_variables = static_cast<int>(variables);
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
 }
 
 }  // namespace
@@ -90,11 +91,14 @@ Status SlamGraph::AddFactor(const SlamFactor& f) {
   return Status::Ok();
 }
 
-SlamGraph::Variable& SlamGraph::CreateVariable(uint64_t key, const Pose3& initial, int component) {
+SlamGraph::Variable& SlamGraph::CreateVariable(uint64_t key, const Pose3& initial, int component,
+                                               uint64_t parent) {
   Variable& v = variables_[key];
   v.block.reset(new double[7]);
   PoseToBlock(initial, v.block.get());
   v.component = component;
+  v.parent = parent;
+  creation_order_.push_back(key);
   problem_->AddParameterBlock(v.block.get(), 7, manifold_.get());
   auto& members = components_[component];
   if (members.empty() && component != own_component_) {
@@ -110,6 +114,7 @@ SlamGraph::Variable& SlamGraph::CreateVariable(uint64_t key, const Pose3& initia
 }
 
 void SlamGraph::JoinComponents(int keep, int drop, const Pose3& correction) {
+  ++structure_version_;
   for (uint64_t key : components_[drop]) {
     Variable& v = variables_.at(key);
     PoseToBlock(correction * BlockToPose(v.block.get()), v.block.get());
@@ -130,7 +135,7 @@ void SlamGraph::AnchorToWorld(uint64_t key, const Pose3& pose) {
   }
   auto it = variables_.find(key);
   if (it == variables_.end()) {
-    CreateVariable(key, pose, own_component_);
+    CreateVariable(key, pose, own_component_, key);
   } else if (it->second.component != own_component_) {
     const Pose3 correction = pose * BlockToPose(it->second.block.get()).Inverse();
     JoinComponents(own_component_, it->second.component, correction);
@@ -138,18 +143,18 @@ void SlamGraph::AnchorToWorld(uint64_t key, const Pose3& pose) {
 }
 
 void SlamGraph::Insert(const SlamFactor& f) {
-  ceres::CostFunction* cost = nullptr;
   ceres::LossFunction* loss = IsRobustFactor(f.kind) ? cauchy_.get() : nullptr;
+  ceres::CostFunction* cost = MakeFactorCostFunction(f);
   ceres::ResidualBlockId id = nullptr;
   if (f.kind == FactorKind::kPrior || f.kind == FactorKind::kAbsolutePose) {
     AnchorToWorld(f.a, f.z);
-    cost = AbsolutePoseResidual::Create(f.z, f.information);
     id = problem_->AddResidualBlock(cost, loss, variables_.at(f.a).block.get());
   } else if (f.kind == FactorKind::kAbsolutePosition) {
     // Translates a floating component onto the fix but keeps it floating: one position does not
     // fix its orientation.
     Variable& v = variables_.at(f.a);
     if (v.component != own_component_) {
+      ++structure_version_;
       const Pose3 here = BlockToPose(v.block.get());
       const Pose3 shift{f.position - here.t, Eigen::Quaterniond::Identity()};
       for (uint64_t key : components_[v.component]) {
@@ -157,20 +162,19 @@ void SlamGraph::Insert(const SlamFactor& f) {
         PoseToBlock(shift * BlockToPose(b), b);
       }
     }
-    cost = AbsolutePositionResidual::Create(f.position, f.position_information);
     id = problem_->AddResidualBlock(cost, loss, v.block.get());
   } else {
     const bool has_a = HasVariable(f.a), has_b = HasVariable(f.b);
     if (!has_a && !has_b) {
       const int c = next_component_++;
-      CreateVariable(f.a, Pose3(), c);
-      CreateVariable(f.b, f.z, c);
+      CreateVariable(f.a, Pose3(), c, f.a);
+      CreateVariable(f.b, f.z, c, f.a);
     } else if (!has_b) {
       const Variable& a = variables_.at(f.a);
-      CreateVariable(f.b, BlockToPose(a.block.get()) * f.z, a.component);
+      CreateVariable(f.b, BlockToPose(a.block.get()) * f.z, a.component, f.a);
     } else if (!has_a) {
       const Variable& b = variables_.at(f.b);
-      CreateVariable(f.a, BlockToPose(b.block.get()) * f.z.Inverse(), b.component);
+      CreateVariable(f.a, BlockToPose(b.block.get()) * f.z.Inverse(), b.component, f.b);
     } else {
       const Variable& a = variables_.at(f.a);
       const Variable& b = variables_.at(f.b);
@@ -183,79 +187,227 @@ void SlamGraph::Insert(const SlamFactor& f) {
         }
       }
     }
-    cost = RelativePoseResidual::Create(f.z, f.information);
     id = problem_->AddResidualBlock(cost, loss, variables_.at(f.a).block.get(), variables_.at(f.b).block.get());
   }
   double c = 0.0;
   problem_->EvaluateResidualBlock(id, true, &c, nullptr, nullptr);
   new_cost_ += c;
+  const auto index = static_cast<uint32_t>(factors_.size());
+  variables_.at(f.a).factors.push_back(index);
+  if (!IsUnary(f.kind)) variables_.at(f.b).factors.push_back(index);
   factors_.push_back(f);
+  residuals_.push_back({cost, loss});
 }
 
 SlamUpdateStats SlamGraph::Solve(int iterations, double seconds) {
   SlamUpdateStats stats;
   if (problem_->NumResidualBlocks() == 0) return stats;
   const auto start = std::chrono::steady_clock::now();
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  o.max_num_iterations = iterations;
-  o.max_solver_time_in_seconds = seconds;
-  o.function_tolerance = 1e-10;
-  o.gradient_tolerance = 1e-12;
-  o.parameter_tolerance = 1e-10;
-  o.num_threads = 1;
-  ceres::Solver::Summary summary;
-  ceres::Solve(o, problem_.get(), &summary);
+  return StatsOf(SolveGraphProblem(*problem_, iterations, seconds), variables_.size(), start);
+}
+
+std::vector<uint64_t> SlamGraph::WindowAround(const std::vector<uint64_t>& seeds) const {
+  // Breadth first from the seeds, so the cap keeps the nearest variables.
+  const auto cap = static_cast<size_t>(options_.window_variables);
+  std::vector<uint64_t> window;
+  std::set<uint64_t> seen;
+  for (uint64_t key : seeds) {
+    if (window.size() < cap && HasVariable(key) && seen.insert(key).second) window.push_back(key);
+  }
+  size_t level_begin = 0;
+  for (int64_t hop = 0; hop < options_.window_hops && window.size() < cap; ++hop) {
+    const size_t level_end = window.size();
+    for (size_t i = level_begin; i < level_end && window.size() < cap; ++i) {
+      for (uint32_t k : variables_.at(window[i]).factors) {
+        const SlamFactor& f = factors_[k];
+        if (IsUnary(f.kind)) continue;
+        const uint64_t other = f.a == window[i] ? f.b : f.a;
+        if (seen.insert(other).second) {
+          window.push_back(other);
+          if (window.size() >= cap) break;
+        }
+      }
+    }
+    level_begin = level_end;
+  }
+  return window;
+}
+
+SlamUpdateStats SlamGraph::SolveWindow(const std::vector<uint64_t>& seeds) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<uint64_t> window = WindowAround(seeds);
+  std::sort(window.begin(), window.end());
+  auto in_window = [&](uint64_t key) { return std::binary_search(window.begin(), window.end(), key); };
+  // A problem of the window's factors only: the rest of the graph never enters the solver, so the
+  // update's cost does not grow with the graph. The factors' residuals are shared, not copied.
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem local(po);
+  std::vector<uint32_t> used;
+  for (uint64_t key : window) {
+    for (uint32_t k : variables_.at(key).factors) used.push_back(k);
+  }
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  for (uint32_t k : used) {
+    const SlamFactor& f = factors_[k];
+    const Residual& r = residuals_[k];
+    if (IsUnary(f.kind)) {
+      local.AddResidualBlock(r.cost, r.loss, variables_.at(f.a).block.get());
+    } else {
+      local.AddResidualBlock(r.cost, r.loss, variables_.at(f.a).block.get(), variables_.at(f.b).block.get());
+    }
+  }
+  std::set<uint64_t> blocks_of_used;
+  for (uint32_t k : used) {
+    blocks_of_used.insert(factors_[k].a);
+    if (!IsUnary(factors_[k].kind)) blocks_of_used.insert(factors_[k].b);
+  }
+  for (uint64_t key : blocks_of_used) {
+    const Variable& v = variables_.at(key);
+    local.SetManifold(v.block.get(), manifold_.get());
+    if (v.gauge || !in_window(key)) local.SetParameterBlockConstant(v.block.get());
+  }
+  // A window only has to be good until the next full solve: a looser tolerance than the full
+  // solve's saves the last iterations.
+  const GraphSolveResult r =
+      SolveGraphProblem(local, static_cast<int>(options_.update_iterations), options_.update_seconds,
+                        options_.window_tolerance);
+  if (!r.converged) unconverged_ = seeds;
+  return StatsOf(r, window.size(), start);
+}
+
+GraphSnapshot SlamGraph::Snapshot() const {
+  GraphSnapshot s;
+  s.factors = factors_;
+  s.keys.reserve(variables_.size());
+  s.poses.reserve(variables_.size());
+  s.constant.reserve(variables_.size());
+  for (const auto& [key, v] : variables_) {
+    s.keys.push_back(key);
+    s.poses.push_back(BlockToPose(v.block.get()));
+    s.constant.push_back(v.gauge ? 1 : 0);
+  }
+  return s;
+}
+
+void SlamGraph::StartFullSolve(bool chordal) {
+  job_ = std::make_shared<GraphBatchJob>(Snapshot(), chordal, options_.cauchy_c, options_.full_iterations,
+                                         structure_version_);
+  job_factors_ = factors_.size();
+  job_variables_ = creation_order_.size();
+  full_solve_wanted_ = chordal_wanted_ = false;
+  runner_([job = job_] { job->Run(); });
+}
+
+bool SlamGraph::MergeFullSolve() {
+  const std::shared_ptr<GraphBatchJob> job = std::move(job_);
+  if (job->version() != structure_version_) {
+    ++stale_full_solves_;
+    return false;
+  }
+  ++full_solves_;
+  const GraphSnapshot& r = job->result();
+  // Left corrections: the solved pose of each snapshot variable times its current pose's inverse
+  // (which may include window updates made meanwhile, superseded by the full solve).
+  std::map<uint64_t, Pose3> correction;
+  for (size_t i = 0; i < r.keys.size(); ++i) {
+    Variable& v = variables_.at(r.keys[i]);
+    correction[r.keys[i]] = r.poses[i] * BlockToPose(v.block.get()).Inverse();
+    PoseToBlock(r.poses[i], v.block.get());
+  }
+  // Variables created meanwhile follow the variable they were placed from (creation order, so a
+  // parent's correction is known before its children's).
+  for (size_t k = job_variables_; k < creation_order_.size(); ++k) {
+    const uint64_t key = creation_order_[k];
+    Variable& v = variables_.at(key);
+    auto it = correction.find(v.parent);
+    if (it == correction.end()) continue;  // a new anchor or floating component: not in the solve
+    const Pose3 c = it->second;
+    PoseToBlock(c * BlockToPose(v.block.get()), v.block.get());
+    correction[key] = c;
+  }
+  return true;
+}
+
+void SlamGraph::WaitForBackground() {
+  if (!job_) return;
+  job_->Wait();
+  const size_t first_new = job_factors_;
+  if (!MergeFullSolve()) {
+    full_solve_wanted_ = true;
+    return;
+  }
+  for (size_t k = factors_.size(); k-- > first_new;) {  // newest first, as the window takes them
+    unconverged_.push_back(factors_[k].a);
+    if (!IsUnary(factors_[k].kind)) unconverged_.push_back(factors_[k].b);
+  }
+}
+
+SlamUpdateStats SlamGraph::Update() {
+  const auto start = std::chrono::steady_clock::now();
+  SlamUpdateStats merged;
+  if (job_ && job_->Done()) {
+    merged.reinitialized = job_->reinitialized();
+    const int stale_before = stale_full_solves_;
+    WaitForBackground();
+    merged.full_solve_merged = stale_full_solves_ == stale_before;
+    if (!merged.full_solve_merged) merged.reinitialized = false;
+  }
+  // Newest factors first: when more arrived than one window holds, the older ones wait for the
+  // full solve that their cost has asked for.
+  std::vector<uint64_t> seeds;
+  if (new_cost_ > options_.update_min_cost) {
+    for (size_t k = factors_.size(); k-- > solved_factors_;) {
+      seeds.push_back(factors_[k].a);
+      if (!IsUnary(factors_[k].kind)) seeds.push_back(factors_[k].b);
+    }
+    if (new_cost_ > options_.full_solve_cost) full_solve_wanted_ = true;
+    if (options_.reinitialize_cost > 0.0 && new_cost_ > options_.reinitialize_cost) chordal_wanted_ = true;
+  }
+  seeds.insert(seeds.end(), unconverged_.begin(), unconverged_.end());
+  unconverged_.clear();
   new_cost_ = 0.0;
-  unconverged_ = summary.termination_type != ceres::CONVERGENCE;
-  stats.solved = true;
-  stats.iterations = static_cast<int>(summary.iterations.size()) - 1;
-  stats.cost = summary.final_cost;
+  solved_factors_ = factors_.size();
+  SlamUpdateStats stats;
+  if (!runner_ && full_solve_wanted_) {
+    // Inline: the full solve covers the window.
+    const bool reinitialized = chordal_wanted_ && ReinitializeChordal().ok();
+    full_solve_wanted_ = chordal_wanted_ = false;
+    stats = SolveFull();
+    stats.reinitialized = reinitialized;
+    stats.full_solve_merged = true;
+    ++full_solves_;
+  } else {
+    if (!seeds.empty()) stats = SolveWindow(seeds);
+    if (full_solve_wanted_ && !job_) {
+      StartFullSolve(chordal_wanted_);
+      stats.full_solve_started = true;
+    }
+  }
+  stats.full_solve_merged = stats.full_solve_merged || merged.full_solve_merged;
+  stats.reinitialized = stats.reinitialized || merged.reinitialized;
+  stats.solved = stats.solved || merged.full_solve_merged;
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 
-SlamUpdateStats SlamGraph::Update() {
-  if (new_cost_ <= options_.update_min_cost && !unconverged_) return {};
-  if (options_.reinitialize_cost > 0.0 && new_cost_ > options_.reinitialize_cost) {
-    const auto start = std::chrono::steady_clock::now();
-    const bool reinitialized = ReinitializeChordal().ok();
-    SlamUpdateStats stats = SolveFull();
-    stats.reinitialized = reinitialized;
-    stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return stats;
-  }
-  return Solve(static_cast<int>(options_.update_iterations), options_.update_seconds);
-}
-
 Status SlamGraph::ReinitializeChordal() {
-  PoseGraph g;
-  // Anchors first: InitializeChordal keeps the first vertex of each component.
-  for (const auto& f : factors_) {
-    if (f.kind == FactorKind::kPrior || f.kind == FactorKind::kAbsolutePose) g.SetVertex(f.a, *Pose(f.a));
-  }
-  for (const auto& [key, v] : variables_) {
-    if (v.gauge) g.SetVertex(key, *Pose(key));
-  }
-  for (const auto& [key, v] : variables_) {
-    if (!g.HasVertex(key)) g.SetVertex(key, *Pose(key));
-  }
-  for (const auto& f : factors_) {
-    if (IsUnary(f.kind)) continue;
-    PoseGraphEdge e;
-    e.from = f.a;
-    e.to = f.b;
-    e.T_from_to = f.z;
-    e.information = f.information;
-    PoseGraph::SetIsotropicWeights(e);
-    g.AddEdge(e);
-  }
-  CAIRN_RETURN_IF_ERROR(InitializeChordal(g));
-  for (size_t i = 0; i < g.num_vertices(); ++i) PoseToBlock(g.poses()[i], variables_.at(g.ids()[i]).block.get());
+  GraphSnapshot s = Snapshot();
+  CAIRN_RETURN_IF_ERROR(InitializeSnapshotChordal(s));
+  ++structure_version_;
+  for (size_t i = 0; i < s.keys.size(); ++i) PoseToBlock(s.poses[i], variables_.at(s.keys[i]).block.get());
   return Status::Ok();
 }
 
-SlamUpdateStats SlamGraph::SolveFull() { return Solve(static_cast<int>(options_.full_iterations), 1e9); }
+SlamUpdateStats SlamGraph::SolveFull() {
+  WaitForBackground();
+  unconverged_.clear();
+  full_solve_wanted_ = chordal_wanted_ = false;
+  return Solve(static_cast<int>(options_.full_iterations), 1e9);
+}
 
 Expected<Pose3> SlamGraph::Pose(uint64_t key) const {
   auto it = variables_.find(key);

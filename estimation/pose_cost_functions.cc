@@ -1,0 +1,125 @@
+#include "estimation/pose_cost_functions.h"
+
+#include "estimation/so3.h"
+
+namespace cairn {
+namespace {
+
+using RowJacobian6 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+using RowJacobian12 = Eigen::Matrix<double, 12, 7, Eigen::RowMajor>;
+using Matrix43 = Eigen::Matrix<double, 4, 3>;
+
+Eigen::Quaterniond QuaternionOf(const double* p) { return Eigen::Quaterniond(p[6], p[3], p[4], p[5]); }
+
+// pinv of the quaternion part of PoseManifold's PlusJacobian (rows x y z w, left increment):
+// P = 1/2 [w I - [v]x; -v^T], whose columns are orthogonal with norm |q|/2.
+Eigen::Matrix<double, 3, 4> PlusJacobianPseudoInverse(const double* p) {
+  const double x = p[3], y = p[4], z = p[5], w = p[6];
+  Matrix43 P;
+  P << w, z, -y,
+      -z, w, x,
+       y, -x, w,
+      -x, -y, -z;
+  P *= 0.5;
+  return P.transpose() / (0.25 * (x * x + y * y + z * z + w * w));
+}
+
+// Writes [J_t | J_rot * pinv(P)] for a residual with tangent Jacobian J (M x 6) into `out` (M x 7).
+template <int M>
+void ToAmbient(const Eigen::Matrix<double, M, 6>& J, const double* p, double* out) {
+  Eigen::Map<Eigen::Matrix<double, M, 7, Eigen::RowMajor>> A(out);
+  A.template leftCols<3>() = J.template leftCols<3>();
+  A.template rightCols<4>() = J.template rightCols<3>() * PlusJacobianPseudoInverse(p);
+}
+
+}  // namespace
+
+RelativePoseCost::RelativePoseCost(const Pose3& T_i_j, const Matrix6d& information)
+    : t_ij_(T_i_j.t), q_ji_(T_i_j.q.conjugate()), sqrt_info_(information.llt().matrixU()) {}
+
+bool RelativePoseCost::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const double* pi = parameters[0];
+  const double* pj = parameters[1];
+  const Eigen::Quaterniond qi = QuaternionOf(pi).normalized(), qj = QuaternionOf(pj).normalized();
+  const Eigen::Vector3d d = Eigen::Vector3d(pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]);
+  const Eigen::Matrix3d Ri_T = qi.conjugate().toRotationMatrix();
+  const Eigen::Matrix3d Rji = q_ji_.toRotationMatrix();
+  Vector6d e;
+  e.head<3>() = Rji * (Ri_T * d - t_ij_);
+  e.tail<3>() = so3::Log(q_ji_ * qi.conjugate() * qj);
+  Eigen::Map<Vector6d>{residuals} = sqrt_info_ * e;
+  if (jacobians == nullptr) return true;
+  // Left perturbations t' = t + dt, R' = Exp(phi) R:
+  //   de_t/dt_i = -R_ji R_i^T, de_t/dt_j = R_ji R_i^T, de_t/dphi_i = R_ji R_i^T [d]x;
+  //   de_r/dphi_j = Jr^-1(e_r) R_j^T = -de_r/dphi_i.
+  const Eigen::Matrix3d A = Rji * Ri_T;
+  const Eigen::Matrix3d B = so3::RightJacobianInverse(e.tail<3>()) * qj.conjugate().toRotationMatrix();
+  if (jacobians[0] != nullptr) {
+    Matrix6d J = Matrix6d::Zero();
+    J.topLeftCorner<3, 3>() = -A;
+    J.topRightCorner<3, 3>() = A * so3::Skew(d);
+    J.bottomRightCorner<3, 3>() = -B;
+    ToAmbient<6>(sqrt_info_ * J, pi, jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    Matrix6d J = Matrix6d::Zero();
+    J.topLeftCorner<3, 3>() = A;
+    J.bottomRightCorner<3, 3>() = B;
+    ToAmbient<6>(sqrt_info_ * J, pj, jacobians[1]);
+  }
+  return true;
+}
+
+ChordalCost::ChordalCost(const Pose3& T_i_j, double kappa, double tau)
+    : R_ij_(T_i_j.R()), t_ij_(T_i_j.t), sqrt_kappa_(std::sqrt(kappa)), sqrt_tau_(std::sqrt(tau)) {}
+
+bool ChordalCost::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const double* pi = parameters[0];
+  const double* pj = parameters[1];
+  const Eigen::Matrix3d Ri = QuaternionOf(pi).normalized().toRotationMatrix();
+  const Eigen::Matrix3d Rj = QuaternionOf(pj).normalized().toRotationMatrix();
+  const Eigen::Vector3d Rt = Ri * t_ij_;
+  const Eigen::Matrix3d M = Ri * R_ij_;
+  const Eigen::Vector3d et = Eigen::Vector3d(pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]) - Rt;
+  const Eigen::Matrix3d eR = Rj - M;
+  for (int k = 0; k < 3; ++k) residuals[k] = sqrt_tau_ * et[k];
+  for (int k = 0; k < 9; ++k) residuals[3 + k] = sqrt_kappa_ * eR(k % 3, k / 3);
+  if (jacobians == nullptr) return true;
+  // Exp(phi) R c = R c - [R c]x phi for each column c.
+  if (jacobians[0] != nullptr) {
+    Eigen::Matrix<double, 12, 6> J = Eigen::Matrix<double, 12, 6>::Zero();
+    J.topLeftCorner<3, 3>() = -sqrt_tau_ * Eigen::Matrix3d::Identity();
+    J.topRightCorner<3, 3>() = sqrt_tau_ * so3::Skew(Rt);
+    for (int c = 0; c < 3; ++c) J.block<3, 3>(3 + 3 * c, 3) = sqrt_kappa_ * so3::Skew(M.col(c));
+    ToAmbient<12>(J, pi, jacobians[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::Matrix<double, 12, 6> J = Eigen::Matrix<double, 12, 6>::Zero();
+    J.topLeftCorner<3, 3>() = sqrt_tau_ * Eigen::Matrix3d::Identity();
+    for (int c = 0; c < 3; ++c) J.block<3, 3>(3 + 3 * c, 3) = -sqrt_kappa_ * so3::Skew(Rj.col(c));
+    ToAmbient<12>(J, pj, jacobians[1]);
+  }
+  return true;
+}
+
+AbsolutePoseCost::AbsolutePoseCost(const Pose3& Z, const Matrix6d& information)
+    : t_(Z.t), q_inv_(Z.q.conjugate()), sqrt_info_(information.llt().matrixU()) {}
+
+bool AbsolutePoseCost::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const double* p = parameters[0];
+  const Eigen::Quaterniond q = QuaternionOf(p).normalized();
+  const Eigen::Matrix3d Rz_T = q_inv_.toRotationMatrix();
+  Vector6d e;
+  e.head<3>() = Rz_T * (Eigen::Vector3d(p[0], p[1], p[2]) - t_);
+  e.tail<3>() = so3::Log(q_inv_ * q);
+  Eigen::Map<Vector6d>{residuals} = sqrt_info_ * e;
+  if (jacobians == nullptr || jacobians[0] == nullptr) return true;
+  // Rz^T Exp(phi) R = (Rz^T R) Exp(R^T phi).
+  Matrix6d J = Matrix6d::Zero();
+  J.topLeftCorner<3, 3>() = Rz_T;
+  J.bottomRightCorner<3, 3>() = so3::RightJacobianInverse(e.tail<3>()) * q.conjugate().toRotationMatrix();
+  ToAmbient<6>(sqrt_info_ * J, p, jacobians[0]);
+  return true;
+}
+
+}  // namespace cairn
