@@ -104,13 +104,7 @@ TEST(MarginalCovarianceTest, MatchesCeresCovarianceOnASlamGraph) {
     for (uint64_t k = 0; k < 4; ++k) keys.push_back(VariableKey(VariableKind::kSubmap, robot, k));
   }
   auto factor = [&](FactorKind kind, uint64_t a, uint64_t b, const Pose3& z) {
-    SlamFactor f;
-    f.kind = kind;
-    f.a = a;
-    f.b = b;
-    f.z = z;
-    f.information = info;
-    ASSERT_TRUE(g.AddFactor(f).ok());
+    ASSERT_TRUE(g.AddFactor(SlamFactor{.kind = kind, .a = a, .b = b, .z = z, .information = info}).ok());
   };
   factor(FactorKind::kPrior, keys[0], 0, P(0, 0, 0));
   for (int r = 0; r < 2; ++r) {
