@@ -92,6 +92,7 @@ void MarginalCovariance::Add(int i, int j, const Matrix6d& info) {
 }
 
 Status MarginalCovariance::Compute() {
+  if (diagonal_.empty()) return Status::Ok();  // only constant blocks: nothing to invert
   Analyze();
   CAIRN_RETURN_IF_ERROR(Factorize());
   SelectedInversion();

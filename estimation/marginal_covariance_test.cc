@@ -190,6 +190,14 @@ TEST(MarginalCovarianceTest, RejectsAProblemWithoutGauge) {
   auto mc = MarginalCovariance::FromProblem(problem);
   ASSERT_TRUE(mc.ok());
   EXPECT_EQ(mc->Compute().code(), StatusCode::kFailedPrecondition);
+
+  // All blocks constant: nothing to invert, no block has a covariance of its own.
+  problem.SetParameterBlockConstant(a.data());
+  problem.SetParameterBlockConstant(b.data());
+  auto fixed = MarginalCovariance::FromProblem(problem);
+  ASSERT_TRUE(fixed.ok());
+  EXPECT_TRUE(fixed->Compute().ok());
+  EXPECT_EQ(fixed->IndexOf(a.data()), -1);
 }
 
 }  // namespace
