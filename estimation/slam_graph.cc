@@ -6,6 +6,7 @@
 #include <ceres/ceres.h>
 
 #include "estimation/graph_batch_job.h"
+#include "estimation/marginal_covariance.h"
 #include "estimation/pose_factors.h"
 #include "estimation/so3.h"
 
@@ -466,26 +467,14 @@ Expected<std::vector<Matrix6d>> SlamGraph::Covariances(const std::vector<uint64_
     stale.push_back(key);
   }
   if (!stale.empty()) {
-    ceres::Covariance::Options co;
-    co.algorithm_type = ceres::SPARSE_QR;
-    co.num_threads = 1;
-    ceres::Covariance covariance(co);
-    std::vector<std::pair<const double*, const double*>> pairs;
-    for (uint64_t key : stale) {
-      const double* b = variables_.at(key).block.get();
-      pairs.emplace_back(b, b);
-    }
-    if (!covariance.Compute(pairs, problem_.get())) {
-      return FailedPreconditionError("covariance: the graph's information matrix is rank deficient");
-    }
+    // All blocks' marginals come out of one selected inversion, so refresh every stale key at once.
+    auto covariance = MarginalCovariance::FromProblem(*problem_);
+    if (!covariance.ok()) return covariance.status();
+    if (Status s = covariance->Compute(); !s.ok()) return s.WithContext("covariance");
     ++covariance_computations_;
     for (uint64_t key : stale) {
-      const double* b = variables_.at(key).block.get();
-      Matrix6d C;
-      Eigen::Matrix<double, 6, 6, Eigen::RowMajor> row_major;
-      covariance.GetCovarianceBlockInTangentSpace(b, b, row_major.data());
-      C = row_major;
-      covariance_cache_[key] = {*Pose(key), C};
+      const int i = covariance->IndexOf(variables_.at(key).block.get());
+      covariance_cache_[key] = {*Pose(key), i < 0 ? Matrix6d::Zero() : covariance->Marginal(i)};  // gauge: 0
     }
     covariance_factor_count_ = factors_.size();
   }
