@@ -1,6 +1,7 @@
 #include "estimation/pose_graph_solver.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "estimation/chordal_initializer.h"
@@ -19,7 +20,7 @@ constexpr double kGncDefaultThreshold = 22.46;
 // After PCM: the chi-square probability beyond which a kept closure's residual rejects it, and
 // how many screening solves at most.
 constexpr double kResidualConfidence = 0.999;
-constexpr int kResidualRounds = 3;
+constexpr int kResidualRounds = 6;
 
 // The graph of the edges `keep` marks, same vertices in the same order.
 PoseGraph KeptEdges(const PoseGraph& graph, const std::vector<bool>& keep) {
@@ -48,9 +49,10 @@ Expected<PoseGraphSolveSummary> SolveKeptEdges(PoseGraph& graph, const PoseGraph
   std::vector<bool> keep = pcm->keep;
   PoseGraphSolverOptions inner = options;
   inner.outliers = PoseGraphSolverOptions::Outliers::kNone;
-  PoseGraphSolverOptions screen = inner;
-  screen.cauchy_c = options.cauchy_c > 0.0 ? options.cauchy_c : 1.0;
   const double threshold = ChiSquareQuantile(kResidualConfidence, graph.planar() ? 3 : 6);
+  // Cauchy scale at the threshold: true closures keep nearly full weight, the rest pull little.
+  PoseGraphSolverOptions screen = inner;
+  screen.cauchy_c = options.cauchy_c > 0.0 ? options.cauchy_c : std::sqrt(threshold);
   int screened = 0;
   for (int round = 0; round < kResidualRounds; ++round) {
     PoseGraph kept = KeptEdges(graph, keep);
