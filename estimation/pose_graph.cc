@@ -105,14 +105,6 @@ double GeodesicChi2(const PoseGraph& g) {
   return chi2;
 }
 
-namespace {
-
-bool IsOdometry(const PoseGraphEdge& e) {
-  return RobotOfKey(e.from) == RobotOfKey(e.to) && e.to == e.from + 1;
-}
-
-}  // namespace
-
 void InitializeFromSpanningTree(PoseGraph& g) {
   const size_t n = g.num_vertices();
   std::vector<std::vector<std::pair<size_t, int>>> adjacency(n);  // edge index, direction
@@ -129,7 +121,7 @@ void InitializeFromSpanningTree(PoseGraph& g) {
       queue.pop();
       for (const auto& [k, dir] : adjacency[v]) {
         const auto& e = g.edges()[k];
-        if (odometry_only && !IsOdometry(e)) continue;
+        if (odometry_only && !IsOdometryEdge(e)) continue;
         const size_t w = dir > 0 ? g.Find(e.to) : g.Find(e.from);
         if (seen[w]) continue;
         seen[w] = true;

@@ -83,6 +83,11 @@ class PoseGraph {
   bool has_estimate_ = false;
 };
 
+// Robot odometry: consecutive indices of one robot, from the lower to the higher.
+constexpr bool IsOdometryEdge(const PoseGraphEdge& e) {
+  return RobotOfKey(e.from) == RobotOfKey(e.to) && e.to == e.from + 1;
+}
+
 // Objectives evaluated in double, independent of the solver:
 // SE-Sync: sum kappa*||R_j - R_i R_ij||_F^2 + tau*||t_j - t_i - R_i t_ij||^2 (no 1/2).
 double SeSyncCost(const PoseGraph& g);

@@ -1,9 +1,11 @@
 #include "estimation/pose_graph_solver.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "estimation/chordal_initializer.h"
+#include "estimation/pairwise_consistency.h"
 #include "estimation/pose_factors.h"
 
 namespace cairn {
@@ -15,24 +17,101 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 // Squared whitened residual beyond which GNC rejects a closure: chi-square, 6 dof, 99.9 %.
 constexpr double kGncDefaultThreshold = 22.46;
+// After PCM: the chi-square probability beyond which a kept closure's residual rejects it, and
+// how many screening solves at most.
+constexpr double kResidualConfidence = 0.999;
+constexpr int kResidualRounds = 6;
+
+// The graph of the edges `keep` marks, same vertices in the same order.
+PoseGraph KeptEdges(const PoseGraph& graph, const std::vector<bool>& keep) {
+  PoseGraph kept;
+  for (size_t v = 0; v < graph.num_vertices(); ++v) kept.SetVertex(graph.ids()[v], graph.poses()[v]);
+  for (size_t k = 0; k < graph.edges().size(); ++k) {
+    if (keep[k]) kept.AddEdge(graph.edges()[k]);
+  }
+  kept.set_has_initial_estimate(graph.has_initial_estimate());
+  return kept;
+}
+
+// PCM, then the ordinary solve of the graph without the rejected closures (its chordal
+// initialization no longer pulled by them). PCM keeps false closures whose cycles all run through
+// long, uncertain odometry: they agree with every closure within its drift. At the solution of
+// the kept edges (with a Cauchy loss, so that they pull little) they stand out by their residual:
+// closures whose squared whitened residual exceeds the chi-square quantile are dropped and the
+// rest solved again.
+Expected<PoseGraphSolveSummary> SolveKeptEdges(PoseGraph& graph, const PoseGraphSolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PairwiseConsistencyOptions pcm_options;
+  pcm_options.confidence = options.pcm_confidence;
+  auto pcm = FindConsistentLoopClosures(graph, pcm_options);
+  if (!pcm.ok()) return pcm.status();
+  const double pcm_seconds = Seconds(start);
+  std::vector<bool> keep = pcm->keep;
+  PoseGraphSolverOptions inner = options;
+  inner.outliers = PoseGraphSolverOptions::Outliers::kNone;
+  const double threshold = ChiSquareQuantile(kResidualConfidence, graph.planar() ? 3 : 6);
+  // Cauchy scale at the threshold: true closures keep nearly full weight, the rest pull little.
+  PoseGraphSolverOptions screen = inner;
+  screen.cauchy_c = options.cauchy_c > 0.0 ? options.cauchy_c : std::sqrt(threshold);
+  int screened = 0;
+  for (int round = 0; round < kResidualRounds; ++round) {
+    PoseGraph kept = KeptEdges(graph, keep);
+    auto s = SolvePoseGraph(kept, screen);
+    if (!s.ok()) return s.status();
+    bool dropped = false;
+    for (size_t k = 0, j = 0; k < graph.edges().size(); ++k) {
+      if (!keep[k]) continue;
+      const auto& e = kept.edges()[j++];
+      if (!IsLoopClosure(e)) continue;
+      const Vector6d r = GeodesicError(kept.poses()[kept.Find(e.from)], kept.poses()[kept.Find(e.to)], e.T_from_to);
+      if (r.dot(e.information * r) > threshold) {
+        keep[k] = false;
+        dropped = true;
+        ++screened;
+      }
+    }
+    if (!dropped) break;
+  }
+  PoseGraph kept = KeptEdges(graph, keep);
+  auto summary = SolvePoseGraph(kept, inner);
+  if (!summary.ok()) return summary.status();
+  graph.poses() = kept.poses();  // same vertex order
+  summary->outlier_seconds = pcm_seconds;
+  summary->init_seconds += pcm_seconds;
+  for (size_t k = 0; k < keep.size(); ++k) {
+    if (!keep[k]) summary->rejected.push_back(k);
+  }
+  summary->rejected_edges = static_cast<int>(summary->rejected.size());
+  summary->solve_seconds = Seconds(start) - summary->init_seconds;
+  if (options.verbose) {
+    std::fprintf(stderr,
+                 "pcm: %d of %d loop closures rejected, %d groups, %lld pairs, threshold %.3f, %s, %.3f s; "
+                 "%d more by residual\n",
+                 pcm->rejected, pcm->loop_closures, pcm->groups, static_cast<long long>(pcm->pairs_tested),
+                 pcm->threshold, pcm->exact ? "exact" : "greedy", pcm_seconds, screened);
+  }
+  return summary;
+}
 
 }  // namespace
 
-bool IsLoopClosure(const PoseGraphEdge& e) {
-  return !(RobotOfKey(e.from) == RobotOfKey(e.to) && e.to == e.from + 1);
-}
+bool IsLoopClosure(const PoseGraphEdge& e) { return !IsOdometryEdge(e); }
 
 Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options) {
   using Options = PoseGraphSolverOptions;
-  PoseGraphSolveSummary summary;
-  const auto start = std::chrono::steady_clock::now();
   if (options.init == Options::Init::kFile && !graph.has_initial_estimate()) {
     return FailedPreconditionError("--init file: the graph has no vertex estimates");
   }
-  if (options.init == Options::Init::kOdometry || !graph.has_initial_estimate()) {
+  if (options.outliers == Options::Outliers::kPcm) return SolveKeptEdges(graph, options);
+  PoseGraphSolveSummary summary;
+  const auto start = std::chrono::steady_clock::now();
+  const bool gnc = options.outliers == Options::Outliers::kGnc;
+  // GNC starts from odometry: a chordal start over all closures is already bent by the false ones.
+  if (options.init == Options::Init::kOdometry || !graph.has_initial_estimate() ||
+      (gnc && options.init == Options::Init::kChordal)) {
     InitializeFromSpanningTree(graph);
   }
-  if (options.init == Options::Init::kChordal) CAIRN_RETURN_IF_ERROR(InitializeChordal(graph));
+  if (options.init == Options::Init::kChordal && !gnc) CAIRN_RETURN_IF_ERROR(InitializeChordal(graph));
   summary.init_seconds = Seconds(start);
   summary.initial_sesync_cost = SeSyncCost(graph);
 
@@ -122,6 +201,10 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
         max_r2 = std::max(max_r2, s);
       }
     };
+    // Rounds only follow the weights; the final solve converges fully.
+    ceres::Solver::Options round_solver = solver;
+    round_solver.max_num_iterations = static_cast<int>(std::min(options.gnc_round_iterations, options.max_iterations));
+    round_solver.function_tolerance = std::max(solver.function_tolerance, 1e-6);
     evaluate();
     double mu = cbar2 / std::max(2.0 * max_r2 - cbar2, 1e-12);
     for (int round = 0; round < 100 && mu < 1e6; ++round) {
@@ -143,7 +226,7 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
       }
       if (binary && round > 0) break;
       ceres::Solver::Summary round_summary;
-      ceres::Solve(solver, &problem, &round_summary);
+      ceres::Solve(round_solver, &problem, &round_summary);
       summary.iterations += static_cast<int>(round_summary.iterations.size()) - 1;
       evaluate();
       mu *= 1.4;
@@ -153,6 +236,7 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
       if (weight_of_edge[k] < 0) continue;
       const bool rejected = r2[k] > cbar2;
       summary.rejected_edges += rejected ? 1 : 0;
+      if (rejected) summary.rejected.push_back(k);
       weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
           new ceres::ScaledLoss(nullptr, rejected ? 1e-12 : 1.0, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
     }

@@ -4,6 +4,7 @@
 // SE-Sync objective, optionally with a Cauchy loss on loop closures and outlier rejection.
 
 #include <string>
+#include <vector>
 
 #include "estimation/pose_graph.h"
 #include "hal/options_visitor.h"
@@ -14,7 +15,9 @@ namespace cairn {
 struct PoseGraphSolverOptions {
   enum class Objective { kGeodesic, kSeSync };
   enum class Init { kChordal, kOdometry, kFile };
-  enum class Outliers { kNone, kGnc };
+  // kPcm: pairwise-consistency rejection of loop closures, then the solve of the kept edges.
+  // kGnc: graduated non-convexity (truncated least squares) from the odometry initialization.
+  enum class Outliers { kNone, kPcm, kGnc };
   Objective objective = Objective::kGeodesic;
   Init init = Init::kChordal;
   Outliers outliers = Outliers::kNone;
@@ -22,6 +25,10 @@ struct PoseGraphSolverOptions {
   // With GNC, c^2 is the truncation threshold on the squared whitened residual (default 22.46).
   double cauchy_c = 0.0;
   int64_t max_iterations = 200;
+  // Chi-square probability of the pairwise-consistency test of two loop closures (kPcm).
+  double pcm_confidence = 0.99;
+  // Levenberg-Marquardt iterations per GNC round: each round only tracks the changed weights.
+  int64_t gnc_round_iterations = 10;
   // Relative cost change that ends the solve; 0 = per objective: 1e-10 for the geodesic one
   // (quadratic convergence, one more iteration at most), 1e-6 for SE-Sync's (Gauss-Newton
   // converges only linearly on its large residuals; 1e-6 leaves ~3e-6 relative to the optimum).
@@ -32,9 +39,11 @@ struct PoseGraphSolverOptions {
   void Visit(OptionsVisitor& v) {
     v.Choice("objective", objective, {{"geodesic", Objective::kGeodesic}, {"sesync", Objective::kSeSync}});
     v.Choice("init", init, {{"chordal", Init::kChordal}, {"odometry", Init::kOdometry}, {"file", Init::kFile}});
-    v.Choice("outliers", outliers, {{"none", Outliers::kNone}, {"gnc", Outliers::kGnc}});
+    v.Choice("outliers", outliers, {{"none", Outliers::kNone}, {"pcm", Outliers::kPcm}, {"gnc", Outliers::kGnc}});
     v.Number("cauchy_c", cauchy_c, 0.0, 1e6, "sqrt(chi2)");
     v.Integer("max_iterations", max_iterations, 1, 100000, "iterations");
+    v.Number("pcm_confidence", pcm_confidence, 0.5, 0.999999, "probability");
+    v.Integer("gnc_round_iterations", gnc_round_iterations, 1, 100000, "iterations");
     v.Number("function_tolerance", function_tolerance, 0.0, 1.0, "relative");
     v.Integer("threads", threads, 1, 64, "threads");
     v.Flag("verbose", verbose);
@@ -50,12 +59,15 @@ struct PoseGraphSolveSummary {
   double solve_seconds = 0.0;
   int components = 0;
   int rejected_edges = 0;        // loop closures given zero weight by outlier rejection
+  std::vector<size_t> rejected;  // their edge indices, ascending
+  double outlier_seconds = 0.0;  // of the pairwise-consistency search (part of init_seconds)
   std::string termination;
 };
 
 // Loop closure: any edge other than robot odometry (consecutive indices of one robot).
 bool IsLoopClosure(const PoseGraphEdge& e);
 
+// With kPcm the costs in the summary are those of the kept edges.
 Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options);
 
 }  // namespace cairn

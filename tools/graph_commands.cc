@@ -25,12 +25,14 @@ namespace {
 constexpr const char* kSolveUsage =
     "usage: cairn graph solve IN.g2o|DIR [--out OUT.g2o] [--objective geodesic|sesync]\n"
     "                         [--init chordal|odometry|file] [--loss none|cauchy:C]\n"
-    "                         [--outliers none|gnc] [--threads N] [--verbose]\n"
+    "                         [--outliers none|pcm|gnc] [--pcm-confidence P (chi-square probability, 0.99)]\n"
+    "                         [--injected-after N (edges from index N on are false: prints recall)]\n"
+    "                         [--threads N] [--verbose]\n"
     "                         [--tolerance REL (relative cost change that ends the solve)]\n"
     "                         [--reference SOLVED.g2o (prints the ATE against its vertices)]\n";
 
 bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, std::string& reference,
-                    PoseGraphSolverOptions& o) {
+                    long long& injected_after, PoseGraphSolverOptions& o) {
   using O = PoseGraphSolverOptions;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
@@ -59,8 +61,15 @@ bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, 
       char* end = nullptr;
       o.cauchy_c = std::strtod(v.c_str() + 7, &end);
       if (*end != '\0' || !(o.cauchy_c > 0.0)) return false;
-    } else if (a == "--outliers" && (v == "none" || v == "gnc")) {
-      o.outliers = v == "gnc" ? O::Outliers::kGnc : O::Outliers::kNone;
+    } else if (a == "--outliers" && (v == "none" || v == "pcm" || v == "gnc")) {
+      o.outliers = v == "gnc" ? O::Outliers::kGnc : v == "pcm" ? O::Outliers::kPcm : O::Outliers::kNone;
+    } else if (a == "--pcm-confidence") {
+      o.pcm_confidence = std::atof(v.c_str());
+      if (!(o.pcm_confidence >= 0.5 && o.pcm_confidence < 1.0)) return false;
+    } else if (a == "--injected-after") {
+      char* end = nullptr;
+      injected_after = std::strtoll(v.c_str(), &end, 10);
+      if (*end != '\0' || injected_after < 0) return false;
     } else if (a == "--tolerance") {
       o.function_tolerance = std::atof(v.c_str());
       if (!(o.function_tolerance > 0.0 && o.function_tolerance < 1.0)) return false;
@@ -100,8 +109,9 @@ double AbsoluteTrajectoryError(const PoseGraph& g, const PoseGraph& ref) {
 
 int RunGraphSolve(const CommandArgs& args) {
   std::string in, out, reference;
+  long long injected_after = -1;
   PoseGraphSolverOptions options;
-  if (!ParseSolveArgs(args, in, out, reference, options)) {
+  if (!ParseSolveArgs(args, in, out, reference, injected_after, options)) {
     std::fputs(kSolveUsage, stderr);
     return 2;
   }
@@ -110,10 +120,31 @@ int RunGraphSolve(const CommandArgs& args) {
     std::fprintf(stderr, "cairn graph solve: %s\n", graph.status().message().c_str());
     return 1;
   }
+  // Loop closures before the rest are lost with the edges the solve may drop.
+  std::vector<bool> closure(graph->edges().size());
+  for (size_t k = 0; k < closure.size(); ++k) closure[k] = IsLoopClosure(graph->edges()[k]);
   auto summary = SolvePoseGraph(*graph, options);
   if (!summary.ok()) {
     std::fprintf(stderr, "cairn graph solve: %s\n", summary.status().message().c_str());
     return 1;
+  }
+  std::string outlier_stats;
+  if (injected_after >= 0) {
+    // Recall: injected closures rejected; true closures kept.
+    long long injected = 0, true_closures = 0, injected_rejected = 0, true_rejected = 0;
+    std::vector<bool> rejected(closure.size(), false);
+    for (size_t k : summary->rejected) rejected[k] = true;
+    for (size_t k = 0; k < closure.size(); ++k) {
+      if (!closure[k]) continue;
+      const bool is_injected = static_cast<long long>(k) >= injected_after;
+      (is_injected ? injected : true_closures) += 1;
+      if (rejected[k]) (is_injected ? injected_rejected : true_rejected) += 1;
+    }
+    char buffer[256];
+    std::snprintf(buffer, sizeof buffer,
+                  ", \"injected\": %lld, \"injected_rejected\": %lld, \"true_closures\": %lld, \"true_kept\": %lld",
+                  injected, injected_rejected, true_closures, true_closures - true_rejected);
+    outlier_stats = buffer;
   }
   if (!out.empty()) {
     const Status s = WriteG2o(out, *graph);
@@ -135,11 +166,11 @@ int RunGraphSolve(const CommandArgs& args) {
       "{\"input\": \"%s\", \"ate_vs_reference\": %.6g, \"vertices\": %zu, \"edges\": %zu, \"components\": %d, "
       "\"sesync_cost\": %.10g, \"geodesic_chi2\": %.10g, \"initial_sesync_cost\": %.10g, "
       "\"iterations\": %d, \"rejected_edges\": %d, \"init_seconds\": %.4f, \"solve_seconds\": %.4f, "
-      "\"wall_seconds\": %.4f}\n",
+      "\"outlier_seconds\": %.4f, \"wall_seconds\": %.4f%s}\n",
       in.c_str(), ate, graph->num_vertices(), graph->edges().size(), summary->components,
       summary->sesync_cost, summary->geodesic_chi2, summary->initial_sesync_cost, summary->iterations,
-      summary->rejected_edges, summary->init_seconds, summary->solve_seconds,
-      summary->init_seconds + summary->solve_seconds);
+      summary->rejected_edges, summary->init_seconds, summary->solve_seconds, summary->outlier_seconds,
+      summary->init_seconds + summary->solve_seconds, outlier_stats.c_str());
   return 0;
 }
 

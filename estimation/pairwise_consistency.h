@@ -1,0 +1,49 @@
+#pragma once
+// Pairwise-consistency outlier rejection of loop closures (the idea of PCM, Mangelson et al.,
+// ICRA 2018): two closures are consistent when the cycle they close through the odometry is
+// the identity within its uncertainty; the largest set of mutually consistent closures is kept.
+//
+// Odometry chains are maximal runs of consecutive keys of one robot joined by odometry edges;
+// each is dead-reckoned in a frame of its own, so no closure (true or false) enters the poses
+// the test composes. Closures are grouped by the pair of chains they join (intra-robot closures
+// of one chain, inter-robot closures of two robots' chains, ...): only closures of one group
+// close a cycle with each other, and each group gets its own maximum clique.
+//
+// Cycle covariance (first order, documented approximation): every odometry edge and closure
+// noise is a right perturbation in its own frame; it is moved to the chain's dead-reckoning frame
+// by the adjoint of the pose it acts at, so that the covariance of any odometry segment is a
+// difference of prefix sums. The cycle's covariance is the two closures' plus the two segments'
+// (the second chain's carried into the first chain's frame through the first closure). The
+// squared Mahalanobis length of the cycle error is tested against a chi-square quantile with 6
+// degrees of freedom (3 for planar graphs, whose lifted z, roll and pitch carry no information).
+
+#include <vector>
+
+#include "estimation/max_clique.h"
+#include "estimation/pose_graph.h"
+#include "hal/status.h"
+
+namespace cairn {
+
+struct PairwiseConsistencyOptions {
+  double confidence = 0.99;  // chi-square probability of the pairwise test
+  CliqueOptions clique;
+};
+
+struct PairwiseConsistencyResult {
+  std::vector<bool> keep;      // per edge: false for a rejected loop closure
+  int loop_closures = 0;
+  int rejected = 0;
+  int groups = 0;
+  bool exact = true;           // every group's clique is provably maximum
+  double threshold = 0.0;      // on the squared Mahalanobis length of a cycle
+  int64_t pairs_tested = 0;
+};
+
+// Quantile of the chi-square distribution (integer dof >= 1), by bisection on its CDF.
+double ChiSquareQuantile(double probability, int dof);
+
+Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& graph,
+                                                               const PairwiseConsistencyOptions& options);
+
+}  // namespace cairn
