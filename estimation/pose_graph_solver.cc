@@ -206,6 +206,32 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
       }
     };
     // Rounds only follow the weights; the final solve converges fully.
+    // Each solve sees only the edges of non-zero weight: random false closures are long edges that
+    // fill the Cholesky factor in, so dropping them as their weight reaches zero keeps the rounds
+    // (and the final solve) as sparse as the inlier graph.
+    std::vector<double> weight(graph.edges().size(), 1.0);
+    auto solve_active = [&](const ceres::Solver::Options& o, ceres::Solver::Summary* s) {
+      ceres::Problem::Options po;
+      po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+      po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+      po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+      ceres::Problem active(po);
+      std::vector<double*> params;
+      for (size_t k = 0; k < residuals.size(); ++k) {
+        const int wk = weight_of_edge[k];
+        if (wk >= 0 && weight[k] <= 0.0) continue;
+        problem.GetParameterBlocksForResidualBlock(residuals[k], &params);
+        active.AddResidualBlock(const_cast<ceres::CostFunction*>(problem.GetCostFunctionForResidualBlock(residuals[k])),
+                                wk >= 0 ? weights[static_cast<size_t>(wk)].get() : nullptr, params);
+      }
+      for (size_t v = 0; v < n; ++v) {
+        double* b = &blocks[7 * v];
+        if (!active.HasParameterBlock(b)) continue;
+        active.SetManifold(b, manifold.get());
+        if (problem.IsParameterBlockConstant(b)) active.SetParameterBlockConstant(b);
+      }
+      ceres::Solve(o, &active, s);
+    };
     ceres::Solver::Options round_solver = solver;
     round_solver.max_num_iterations = static_cast<int>(std::min(options.gnc_round_iterations, options.max_iterations));
     round_solver.function_tolerance = std::max(solver.function_tolerance, 1e-6);
@@ -225,12 +251,13 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
           w = std::sqrt(cbar2 * mu * (mu + 1.0) / s) - mu;
           binary = false;
         }
+        weight[k] = w;
         weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
             new ceres::ScaledLoss(nullptr, std::max(w, 1e-12), ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
       }
       if (binary && round > 0) break;
       ceres::Solver::Summary round_summary;
-      ceres::Solve(round_solver, &problem, &round_summary);
+      solve_active(round_solver, &round_summary);
       summary.iterations += static_cast<int>(round_summary.iterations.size()) - 1;
       evaluate();
       mu *= 1.4;
@@ -241,11 +268,12 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
       const bool rejected = r2[k] > cbar2;
       summary.rejected_edges += rejected ? 1 : 0;
       if (rejected) summary.rejected.push_back(k);
+      weight[k] = rejected ? 0.0 : 1.0;
       weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
           new ceres::ScaledLoss(nullptr, rejected ? 1e-12 : 1.0, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
     }
     ceres::Solver::Summary final_summary;
-    ceres::Solve(solver, &problem, &final_summary);
+    solve_active(solver, &final_summary);
     summary.iterations += static_cast<int>(final_summary.iterations.size()) - 1;
   }
   summary.solve_seconds = Seconds(start) - summary.init_seconds;
