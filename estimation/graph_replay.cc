@@ -60,11 +60,7 @@ Expected<GraphReplayResult> ReplayPoseGraph(PoseGraph& g, SlamGraphOptions optio
     result.step_seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
   const auto settle = std::chrono::steady_clock::now();
-  // A merged solve may ask for another (factors that arrived while it ran); bounded.
-  for (int round = 0; round < 10 && slam.background_running(); ++round) {
-    slam.WaitForBackground();
-    result.reinitializations += slam.Update().reinitialized ? 1 : 0;
-  }
+  result.reinitializations += slam.Settle();
   result.settle_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - settle).count();
   result.full_solves = slam.full_solves();
   result.stale_full_solves = slam.stale_full_solves();

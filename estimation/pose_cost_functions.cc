@@ -1,5 +1,7 @@
 #include "estimation/pose_cost_functions.h"
 
+#include <ceres/manifold.h>
+
 #include "estimation/so3.h"
 
 namespace cairn {
@@ -7,21 +9,16 @@ namespace {
 
 using RowJacobian6 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
 using RowJacobian12 = Eigen::Matrix<double, 12, 7, Eigen::RowMajor>;
-using Matrix43 = Eigen::Matrix<double, 4, 3>;
 
 Eigen::Quaterniond QuaternionOf(const double* p) { return Eigen::Quaterniond(p[6], p[3], p[4], p[5]); }
 
-// pinv of the quaternion part of PoseManifold's PlusJacobian (rows x y z w, left increment):
-// P = 1/2 [w I - [v]x; -v^T], whose columns are orthogonal with norm |q|/2.
+// pinv of dq/dphi, phi the rotation vector of the left increment. Ceres' quaternion tangent is
+// half of it (Exp(delta) = [sin|delta| delta/|delta|, cos|delta|]), so dq/dphi = P / 2 with P
+// the manifold's PlusJacobian, whose columns are orthogonal with norm |q|: pinv = P^T / (|q|^2 / 2).
 Eigen::Matrix<double, 3, 4> PlusJacobianPseudoInverse(const double* p) {
-  const double x = p[3], y = p[4], z = p[5], w = p[6];
-  Matrix43 P;
-  P << w, z, -y,
-      -z, w, x,
-       y, -x, w,
-      -x, -y, -z;
-  P *= 0.5;
-  return P.transpose() / (0.25 * (x * x + y * y + z * z + w * w));
+  Eigen::Matrix<double, 4, 3, Eigen::RowMajor> P;
+  ceres::EigenQuaternionManifold().PlusJacobian(p + 3, P.data());
+  return P.transpose() / (0.5 * Eigen::Map<const Eigen::Vector4d>(p + 3).squaredNorm());
 }
 
 // Writes [J_t | J_rot * pinv(P)] for a residual with tangent Jacobian J (M x 6) into `out` (M x 7).

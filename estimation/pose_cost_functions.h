@@ -5,8 +5,8 @@
 // tangent-space Jacobian in closed form instead.
 //
 // The Jacobians are valid on PoseManifold() only: Ceres multiplies the 7-column Jacobian by the
-// manifold's PlusJacobian P, so the quaternion columns are J_tangent * pinv(P) (exact: P has
-// orthogonal columns), which gives J_tangent back.
+// manifold's PlusJacobian P, so the quaternion columns are J_tangent * pinv(dq/dtangent) (exact:
+// P has orthogonal columns), which gives J_tangent back.
 
 #include <ceres/sized_cost_function.h>
 

@@ -197,7 +197,7 @@ void SlamGraph::Insert(const SlamFactor& f) {
   variables_.at(f.a).factors.push_back(index);
   if (!IsUnary(f.kind)) variables_.at(f.b).factors.push_back(index);
   factors_.push_back(f);
-  residuals_.push_back({cost, loss});
+  residual_ids_.push_back(id);
 }
 
 SlamUpdateStats SlamGraph::Solve(int iterations, double seconds) {
@@ -252,19 +252,19 @@ SlamUpdateStats SlamGraph::SolveWindow(const std::vector<uint64_t>& seeds) {
   }
   std::sort(used.begin(), used.end());
   used.erase(std::unique(used.begin(), used.end()), used.end());
-  for (uint32_t k : used) {
-    const SlamFactor& f = factors_[k];
-    const Residual& r = residuals_[k];
-    if (IsUnary(f.kind)) {
-      local.AddResidualBlock(r.cost, r.loss, variables_.at(f.a).block.get());
-    } else {
-      local.AddResidualBlock(r.cost, r.loss, variables_.at(f.a).block.get(), variables_.at(f.b).block.get());
-    }
-  }
   std::set<uint64_t> blocks_of_used;
   for (uint32_t k : used) {
-    blocks_of_used.insert(factors_[k].a);
-    if (!IsUnary(factors_[k].kind)) blocks_of_used.insert(factors_[k].b);
+    const SlamFactor& f = factors_[k];
+    const ceres::ResidualBlockId id = residual_ids_[k];
+    ceres::CostFunction* cost = const_cast<ceres::CostFunction*>(problem_->GetCostFunctionForResidualBlock(id));
+    ceres::LossFunction* loss = const_cast<ceres::LossFunction*>(problem_->GetLossFunctionForResidualBlock(id));
+    blocks_of_used.insert(f.a);
+    if (IsUnary(f.kind)) {
+      local.AddResidualBlock(cost, loss, variables_.at(f.a).block.get());
+    } else {
+      blocks_of_used.insert(f.b);
+      local.AddResidualBlock(cost, loss, variables_.at(f.a).block.get(), variables_.at(f.b).block.get());
+    }
   }
   for (uint64_t key : blocks_of_used) {
     const Variable& v = variables_.at(key);
@@ -333,29 +333,40 @@ bool SlamGraph::MergeFullSolve() {
   return true;
 }
 
-void SlamGraph::WaitForBackground() {
-  if (!job_) return;
+bool SlamGraph::MergeRunningJob() {
   job_->Wait();
   const size_t first_new = job_factors_;
   if (!MergeFullSolve()) {
     full_solve_wanted_ = true;
-    return;
+    return false;
   }
   for (size_t k = factors_.size(); k-- > first_new;) {  // newest first, as the window takes them
     unconverged_.push_back(factors_[k].a);
     if (!IsUnary(factors_[k].kind)) unconverged_.push_back(factors_[k].b);
   }
+  return true;
+}
+
+void SlamGraph::WaitForBackground() {
+  if (job_) MergeRunningJob();
+}
+
+int SlamGraph::Settle(int max_rounds) {
+  int reinitializations = 0;
+  for (int round = 0; round < max_rounds && job_; ++round) {
+    WaitForBackground();
+    reinitializations += Update().reinitialized ? 1 : 0;
+  }
+  return reinitializations;
 }
 
 SlamUpdateStats SlamGraph::Update() {
   const auto start = std::chrono::steady_clock::now();
   SlamUpdateStats merged;
   if (job_ && job_->Done()) {
-    merged.reinitialized = job_->reinitialized();
-    const int stale_before = stale_full_solves_;
-    WaitForBackground();
-    merged.full_solve_merged = stale_full_solves_ == stale_before;
-    if (!merged.full_solve_merged) merged.reinitialized = false;
+    const bool reinitialized = job_->reinitialized();
+    merged.full_solve_merged = MergeRunningJob();
+    merged.reinitialized = merged.full_solve_merged && reinitialized;
   }
   // Newest factors first: when more arrived than one window holds, the older ones wait for the
   // full solve that their cost has asked for.

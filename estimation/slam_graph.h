@@ -35,6 +35,10 @@ namespace ceres {
 class Problem;
 class LossFunction;
 class Manifold;
+namespace internal {
+class ResidualBlock;
+}  // namespace internal
+using ResidualBlockId = internal::ResidualBlock*;
 }  // namespace ceres
 
 namespace cairn {
@@ -119,6 +123,9 @@ class SlamGraph {
   SlamUpdateStats SolveFull();
   // Waits for a running full solve and merges it (no further optimization).
   void WaitForBackground();
+  // Waits and updates until no full solve runs (a merged one may start another for the factors
+  // that arrived while it ran), at most `max_rounds` times; returns the re-initializations merged.
+  int Settle(int max_rounds = 10);
   bool background_running() const { return job_ != nullptr; }
   int full_solves() const { return full_solves_; }
   int stale_full_solves() const { return stale_full_solves_; }
@@ -154,10 +161,6 @@ class SlamGraph {
     uint64_t parent = 0;              // the variable it was placed from (itself for anchors)
     std::vector<uint32_t> factors;    // indices into factors_
   };
-  struct Residual {
-    ceres::CostFunction* cost = nullptr;  // owned by problem_
-    ceres::LossFunction* loss = nullptr;
-  };
   void Insert(const SlamFactor& f);
   Variable& CreateVariable(uint64_t key, const Pose3& initial, int component, uint64_t parent);
   // Moves component `drop` rigidly by `correction` (left-multiplied) and merges it into `keep`.
@@ -172,6 +175,8 @@ class SlamGraph {
   void StartFullSolve(bool chordal);
   // Merges a finished full solve; returns false (and drops it) when the graph's structure changed.
   bool MergeFullSolve();
+  // Waits for the running full solve and merges it; returns whether it was merged (not stale).
+  bool MergeRunningJob();
 
   SlamGraphOptions options_;
   std::unique_ptr<ceres::Problem> problem_;
@@ -184,7 +189,7 @@ class SlamGraph {
   int next_component_ = 0;
   std::vector<SlamFactor> pending_;
   std::vector<SlamFactor> factors_;                // inserted ones, for Chi2()
-  std::vector<Residual> residuals_;                // parallel to factors_
+  std::vector<ceres::ResidualBlockId> residual_ids_;  // parallel to factors_
   size_t num_added_factors_ = 0;
   double new_cost_ = 0.0;  // cost of the factors added since the last solve, at insertion
   size_t solved_factors_ = 0;          // factors_[solved_factors_..] are new since the last update

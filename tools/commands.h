@@ -4,6 +4,9 @@
 
 namespace cairn::tools {
 
+// CPU time of the calling thread in ms: on a loaded machine it still measures one core's work.
+double ThreadCpuMs();
+
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
 int RunMcapInfo(const CommandArgs& args);

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cmath>
 #include <cstdlib>
-#include <ctime>
 #include <random>
 #include <string>
 #include <vector>
@@ -355,11 +354,6 @@ int RunBenchGraph(const CommandArgs& args) {
       full_solve_counts;
   // The online thread's own CPU time next to wall time: on a loaded machine (or with the full
   // solve sharing the cores) wall time includes waiting to be scheduled.
-  auto thread_cpu = [] {
-    timespec ts{};
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-  };
   for (int rep = 0; rep < repeats; ++rep) {
     std::mt19937 rng(static_cast<unsigned>(rep + 1));
     std::normal_distribution<double> n(0.0, 1.0);
@@ -389,10 +383,10 @@ int RunBenchGraph(const CommandArgs& args) {
     int windows = 0;
     auto feed = [&](const SlamFactor& f) {
       const auto t0 = std::chrono::steady_clock::now();
-      const double c0 = thread_cpu();
+      const double c0 = ThreadCpuMs();
       if (!g.AddFactor(f).ok()) std::abort();
       const SlamUpdateStats st = g.Update();
-      cpu_times.push_back(thread_cpu() - c0);
+      cpu_times.push_back(1e-3 * (ThreadCpuMs() - c0));
       times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       if (st.solved && !st.full_solve_merged) {
         window_sum += st.window_variables;
@@ -440,10 +434,7 @@ int RunBenchGraph(const CommandArgs& args) {
     maxima.push_back(*std::max_element(times.begin(), times.end()));
     window_sizes.push_back(windows > 0 ? window_sum / windows : 0.0);
     // The online estimate once the last full solve is merged, as a moment later on the robot.
-    for (int round = 0; round < 10 && g.background_running(); ++round) {
-      g.WaitForBackground();
-      g.Update();
-    }
+    g.Settle();
     full_solve_counts.push_back(g.full_solves());
     const auto t0 = std::chrono::steady_clock::now();
     auto cov = g.Covariances(keys);

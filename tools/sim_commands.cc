@@ -88,14 +88,13 @@ Expected<CanWheelOptions> LoadCanLayout(const std::string& requested) {
                        "/etc/cairn/rover.yaml); pass --rover-config FILE");
 }
 
-// CPU time of the calling thread: on a loaded machine it still measures the work of one core.
+}  // namespace
+
 double ThreadCpuMs() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
-
-}  // namespace
 
 int RunSim(const CommandArgs& args) {
   std::string world_path, out, rover_config;
