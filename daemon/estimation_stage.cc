@@ -1,6 +1,6 @@
 #include "daemon/estimation_stage.h"
 
-#include <Eigen/Eigenvalues>
+#include "estimation/symmetric_eigen.h"
 
 namespace cairn {
 
@@ -99,8 +99,8 @@ void EstimationStage::Emit(const PendingFrame& f) {
     e.frame_id = pose.frame_id;
     e.T_frame_body = pose.T_frame_body;
     e.T_first_body = T_first_frame_[pose.frame_id % T_first_frame_.size()] * pose.T_frame_body;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(pose.covariance.topLeftCorner<3, 3>());
-    e.position_sigma = std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+    const Eigen::Matrix3d position_cov = pose.covariance.topLeftCorner<3, 3>();
+    e.position_sigma = std::sqrt(std::max(0.0, SymmetricEigenvalues(position_cov).maxCoeff()));
     e.position_covariance = pose.covariance.topLeftCorner<3, 3>();
     e.pose_covariance = pose.covariance;
   }

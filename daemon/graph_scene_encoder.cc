@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
-
 #include "daemon/estimate_encoder.h"
 #include "daemon/foxglove_fields.h"
+#include "estimation/symmetric_eigen.h"
 #include "foxglove/SceneUpdate.pb.h"
 
 namespace cairn {
@@ -49,14 +48,15 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
     position[n.key] = n.T_global.translation();
     foxglove::SpherePrimitive* s = e->add_spheres();
     // The ellipsoid's axes are the covariance's eigenvectors, its diameters 2 x 2 sigma.
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (n.position_covariance + n.position_covariance.transpose()));
-    Eigen::Matrix3d axes = eig.eigenvectors();
+    Eigen::Vector3d lambda = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+    SymmetricEigen(Eigen::Matrix3d(0.5 * (n.position_covariance + n.position_covariance.transpose())), &lambda, &axes);
     if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = axes;
     T.translation() = n.T_global.translation();
     SetFoxglovePose(T, s->mutable_pose());
-    const Eigen::Vector3d d = (4.0 * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt()).cwiseMax(kMinOriginDiameter);
+    const Eigen::Vector3d d = (4.0 * lambda.cwiseMax(0.0).cwiseSqrt()).cwiseMax(kMinOriginDiameter);
     s->mutable_size()->set_x(d.x());
     s->mutable_size()->set_y(d.y());
     s->mutable_size()->set_z(d.z());

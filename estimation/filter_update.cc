@@ -2,9 +2,8 @@
 
 #include <cmath>
 
-#include <Eigen/Cholesky>
-
 #include "estimation/filter_kernels.h"
+#include "estimation/small_cholesky.h"
 #include "estimation/so3.h"
 
 namespace cairn {
@@ -24,24 +23,6 @@ Eigen::Quaterniond ExpCorrection(const Eigen::Vector3d& w) {
   const double real = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
   const double imag = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
   return Eigen::Quaterniond(real, imag * w.x(), imag * w.y(), imag * w.z()).normalized();
-}
-
-// W <- W L^-T in place (L lower triangular), column by column.
-template <int N, int M>
-void SolveLowerTransposedRight(const Eigen::Matrix<double, M, M>& L, Eigen::Matrix<double, N, M>& W) {
-  for (int i = 0; i < M; ++i) {
-    for (int k = 0; k < i; ++k) W.col(i) -= L(i, k) * W.col(k);
-    W.col(i) /= L(i, i);
-  }
-}
-
-// z <- L^-1 z (forward substitution).
-template <int M>
-void SolveLower(const Eigen::Matrix<double, M, M>& L, Eigen::Matrix<double, M, 1>& z) {
-  for (int i = 0; i < M; ++i) {
-    for (int k = 0; k < i; ++k) z(i) -= L(i, k) * z(k);
-    z(i) /= L(i, i);
-  }
 }
 
 // C <- C - V V^T on the current part (on and below the block diagonal) of the clone-clone
@@ -71,15 +52,14 @@ UpdateOutcome CoreUpdate(FilterState& s, const Eigen::Matrix<double, M, kCoreDim
   Eigen::Matrix<double, kCoreDim, M> W = Pc.lazyProduct(H.transpose());  // P H^T, then W_core
   Eigen::Matrix<double, M, M> S = H.lazyProduct(W) + R;
   S = 0.5 * (S + S.transpose()).eval();
-  const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
-  if (llt.info() != Eigen::Success) return UpdateOutcome::kBadCovariance;
-  if (gate > 0.0 && r.dot(llt.solve(r)) > gate) return UpdateOutcome::kGated;
-  const Eigen::Matrix<double, M, M> L = llt.matrixL();
-  SolveLowerTransposedRight<kCoreDim, M>(L, W);
-  Eigen::Matrix<double, kCoreDim, M> Gt = H.transpose();  // becomes (L^-1 H)^T
-  SolveLowerTransposedRight<kCoreDim, M>(L, Gt);
+  Eigen::Matrix<double, M, M> L;
+  if (!small_cholesky::Factor<M>(S, &L)) return UpdateOutcome::kBadCovariance;
   Eigen::Matrix<double, M, 1> z = r;
-  SolveLower<M>(L, z);
+  small_cholesky::SolveLower<M>(L, z);
+  if (gate > 0.0 && z.squaredNorm() > gate) return UpdateOutcome::kGated;  // r^T S^-1 r
+  small_cholesky::SolveLowerTransposedRight<kCoreDim, M>(L, W);
+  Eigen::Matrix<double, kCoreDim, M> Gt = H.transpose();  // becomes (L^-1 H)^T
+  small_cholesky::SolveLowerTransposedRight<kCoreDim, M>(L, Gt);
   const Eigen::Matrix<double, kCoreDim, M> Gphi_t = s.phi.transpose().lazyProduct(Gt);  // (G phi)^T
 
   // Clone rows of W: the true clone-core cross blocks times H^T L^-T.
@@ -189,17 +169,16 @@ UpdateOutcome ApplyRelativePoseUpdate(FilterState& s, const RelativePoseMeasurem
   Matrix6d S = m.covariance;
   S += Hk.lazyProduct(U.middleRows<6>(ik)) + Hc.lazyProduct(U.middleRows<6>(ic));
   S = 0.5 * (S + S.transpose()).eval();
-  const Eigen::LLT<Matrix6d> llt(S);
-  if (llt.info() != Eigen::Success) return UpdateOutcome::kBadCovariance;
-  if (gate > 0.0 && r.dot(llt.solve(r)) > gate) return UpdateOutcome::kGated;
+  Matrix6d L;
+  if (!small_cholesky::Factor<6>(S, &L)) return UpdateOutcome::kBadCovariance;
+  Eigen::Matrix<double, 6, 1> z = r;
+  small_cholesky::SolveLower<6>(L, z);
+  if (gate > 0.0 && z.squaredNorm() > gate) return UpdateOutcome::kGated;  // r^T S^-1 r
 
   // W = P H^T L^-T; P <- P - W W^T on the core block, the (bottom-left) cross block and the
   // current part of the clone block; dx = W L^-1 r.
-  const Matrix6d L = llt.matrixL();
-  SolveLowerTransposedRight<kStateDim, 6>(L, U);
+  small_cholesky::SolveLowerTransposedRight<kStateDim, 6>(L, U);
   const Eigen::Matrix<double, kStateDim, 6>& W = U;
-  Eigen::Matrix<double, 6, 1> z = r;
-  SolveLower<6>(L, z);
   const Eigen::Matrix<double, kStateDim, 1> dx = W.lazyProduct(z);
   const Eigen::Matrix<double, 6, kCoreDim> Wc_t = W.topRows<kCoreDim>().transpose();
   const Eigen::Matrix<double, kCloneDims, 6> Wx = W.bottomRows<kCloneDims>();

@@ -3,22 +3,20 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Cholesky>
-
 #include "estimation/filter_kernels.h"
 #include "estimation/filter_update.h"
+#include "estimation/small_cholesky.h"
 #include "estimation/so3.h"
 #include "estimation/wheel_velocity.h"
 
 namespace cairn {
 namespace {
 
-template <class M>
-bool CovarianceOk(const M& c) {
+template <int N>
+bool CovarianceOk(const Eigen::Matrix<double, N, N>& c) {
   if (!c.allFinite()) return false;
   if ((c - c.transpose()).cwiseAbs().maxCoeff() > 1e-9 * (1.0 + c.cwiseAbs().maxCoeff())) return false;
-  Eigen::LLT<M> llt(c);
-  return llt.info() == Eigen::Success;
+  return small_cholesky::PositiveDefinite<N>(c);
 }
 
 FilterResult FromOutcome(UpdateOutcome o) {
@@ -263,6 +261,7 @@ FilterResult LocalReferenceFilter::Submit(Event e) {
   ev_next_ = sn.event_seq;
   snap_end_ = found + 1;
   replaying_ = true;
+  replay_saved_ = false;
   ++counters_.replays;
   for (uint64_t k = sn.imu_seq; k < imu_end_; ++k) {
     Step(k);
@@ -277,7 +276,11 @@ FilterResult LocalReferenceFilter::ProcessEvent(Event& e) {
   switch (e.kind) {
     case EventKind::kClone:
       if (SlotOf(e.a) < 0) AddClone(e.a);
-      PushSnapshot(current_imu_seq_);
+      // A replay saves only the first clone it passes (where the next late measurement, for the
+      // following frame, starts); the later saved states it invalidates are dropped, and a
+      // measurement for one of those frames replays from that first one.
+      if (!replaying_ || !replay_saved_) PushSnapshot(current_imu_seq_);
+      replay_saved_ = true;
       return FilterResult::kApplied;
     case EventKind::kRelease: {
       const int slot = SlotOf(e.a);

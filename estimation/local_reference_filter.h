@@ -8,7 +8,8 @@
 //
 // Delayed measurements are exact: every input is kept in time order in an IMU ring and an event
 // log, and the filter state is saved right after each clone (the time a relative-pose measurement
-// refers to). A measurement whose time is already past restores the newest saved state before it,
+// refers to; a replay saves again only the first clone it passes, where the next late measurement
+// starts). A measurement whose time is already past restores the newest saved state before it,
 // applies the measurement in its place and re-propagates the buffered IMU data to the present.
 // The result equals in-order processing; the IMU-rate output is never held back, it is corrected
 // when the late measurement arrives. Replays are bounded by max_update_delay.
@@ -220,6 +221,7 @@ class LocalReferenceFilter {
   uint64_t history_begin_ = 0, history_end_ = 0;
   uint64_t current_imu_seq_ = 0;  // snapshot position for an event processed now
   bool replaying_ = false;
+  bool replay_saved_ = false;  // the running replay has saved the state at a clone
 
   StateCovariance scratch_a_, scratch_b_;
 };

@@ -4,39 +4,24 @@
 #include <cmath>
 
 #include <ceres/ceres.h>
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
+#include "estimation/point_pair_residual.h"
+#include "estimation/small_cholesky.h"
 #include "estimation/so3.h"
+#include "estimation/symmetric_eigen.h"
 
 namespace cairn {
 namespace {
 
-// Whitened 3-D difference of one point pair: L^-1 (R p_cur + t - p_kf), Sigma = L L^T.
-struct PointPairResidual {
-  PointPairResidual(const Eigen::Vector3d& kf, const Eigen::Vector3d& cur, const Eigen::Matrix3d& whiten)
-      : kf_(kf), cur_(cur), whiten_(whiten) {}
-
-  template <class T>
-  bool operator()(const T* q_ptr, const T* t_ptr, T* r_ptr) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(q_ptr);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(t_ptr);
-    const Eigen::Matrix<T, 3, 1> d = q * cur_.cast<T>() + t - kf_.cast<T>();
-    Eigen::Map<Eigen::Matrix<T, 3, 1>> r(r_ptr);
-    r = whiten_.cast<T>() * d;
-    return true;
-  }
-
-  Eigen::Vector3d kf_, cur_;
-  Eigen::Matrix3d whiten_;
-};
-
 // Inverse Cholesky factor of the combined covariance of a pair under rotation R.
 bool Whitening(const StereoPoint& kf, const StereoPoint& cur, const Eigen::Matrix3d& R, Eigen::Matrix3d* W) {
   const Eigen::Matrix3d S = kf.cov + R * cur.cov * R.transpose();
-  const Eigen::LLT<Eigen::Matrix3d> llt(S);
-  if (llt.info() != Eigen::Success) return false;
-  *W = llt.matrixL().solve(Eigen::Matrix3d::Identity());
+  Eigen::Matrix3d L;
+  if (!small_cholesky::Factor<3>(S, &L)) return false;
+  // W = L^-1: W^T = L^-T, i.e. the identity times L^-T.
+  Eigen::Matrix3d Wt = Eigen::Matrix3d::Identity();
+  small_cholesky::SolveLowerTransposedRight<3, 3>(L, Wt);
+  *W = Wt.transpose();
   return true;
 }
 
@@ -71,9 +56,12 @@ bool StereoPoseEstimator::GaussNewtonStep(std::span<const StereoPoint> kf, std::
     H.noalias() += J.transpose() * J;
     g.noalias() += J.transpose() * (W * (*R * cur[i].p + *t - kf[i].p));
   }
-  const Eigen::LDLT<Matrix6d> ldlt(H);
-  if (ldlt.info() != Eigen::Success) return false;
-  const Vector6d dx = -ldlt.solve(g);
+  // H = L L^T: dx = -L^-T L^-1 g.
+  Matrix6d L;
+  if (!small_cholesky::Factor<6>(H, &L)) return false;
+  Vector6d dx = -g;
+  small_cholesky::SolveLower<6>(L, dx);
+  small_cholesky::SolveLowerTransposed<6>(L, dx);
   if (!dx.allFinite()) return false;
   *t += dx.head<3>();
   *R = *R * so3::Exp(dx.tail<3>());
@@ -92,8 +80,12 @@ int StereoPoseEstimator::Score(const Eigen::Matrix3d& R, const Eigen::Vector3d& 
     // viewing rays, so the exact test needs the hypothesis' rotation.
     if (d2 < options_.inlier_chi2 * trace_bound_[i]) {
       const Eigen::Matrix3d S = kf[i].cov + R * cur[i].cov * R.transpose();
-      const Eigen::LLT<Eigen::Matrix3d> llt(S);
-      in = llt.info() == Eigen::Success && llt.matrixL().solve(d).squaredNorm() < options_.inlier_chi2;
+      Eigen::Matrix3d L;
+      Eigen::Vector3d z = d;
+      if (small_cholesky::Factor<3>(S, &L)) {
+        small_cholesky::SolveLower<3>(L, z);
+        in = z.squaredNorm() < options_.inlier_chi2;
+      }
     }
     (*mask)[i] = in ? 1 : 0;
     n += in ? 1 : 0;
@@ -113,9 +105,7 @@ bool StereoPoseEstimator::Refine(std::span<const StereoPoint> kf, std::span<cons
     if (!inliers_[i]) continue;
     Eigen::Matrix3d W;
     if (!Whitening(kf[i], cur[i], *R, &W)) continue;
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PointPairResidual, 3, 4, 3>(
-                                 new PointPairResidual(kf[i].p, cur[i].p, W)),
-                             nullptr, q.coeffs().data(), tt.data());
+    problem.AddResidualBlock(new PointPairResidual(kf[i].p, cur[i].p, W), nullptr, q.coeffs().data(), tt.data());
     ++used;
   }
   if (used < 3) return false;
@@ -250,19 +240,19 @@ PoseEstimate StereoPoseEstimator::Estimate(std::span<const StereoPoint> kf, std:
     chi2 += (W * (R * cur[i].p + t - kf[i].p)).squaredNorm();
   }
   out.rms_mahalanobis = std::sqrt(chi2 / (3.0 * best));
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(H);
-  if (eig.info() != Eigen::Success || eig.eigenvalues().minCoeff() <= 1e-12 * std::max(1.0, eig.eigenvalues().maxCoeff())) {
+  Vector6d ev;
+  Matrix6d V;
+  if (!SymmetricEigen(H, &ev, &V) || ev.minCoeff() <= 1e-12 * std::max(1.0, ev.maxCoeff())) {
     out.status = VoStatus::kDegenerate;
     return out;
   }
-  out.covariance = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+  out.covariance = V * ev.cwiseInverse().asDiagonal() * V.transpose();
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose()).eval();
   out.T_kf_cur.linear() = R;
   out.T_kf_cur.translation() = t;
-  // Symmetric blocks: the self-adjoint solver (the general one is costly to compile).
   const Eigen::Matrix3d cov_t = out.covariance.topLeftCorner<3, 3>(), cov_r = out.covariance.bottomRightCorner<3, 3>();
-  const double sigma_t = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov_t, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
-  const double sigma_r = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov_r, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff());
+  const double sigma_t = std::sqrt(SymmetricEigenvalues(cov_t).maxCoeff());
+  const double sigma_r = std::sqrt(SymmetricEigenvalues(cov_r).maxCoeff());
   if (sigma_t > options_.max_sigma_translation || sigma_r * 180.0 / M_PI > options_.max_sigma_rotation_deg) {
     out.status = VoStatus::kDegenerate;
     return out;

@@ -1,6 +1,6 @@
 #include "estimation/topology_builder.h"
 
-#include <Eigen/Eigenvalues>
+#include "estimation/symmetric_eigen.h"
 
 namespace cairn {
 namespace {
@@ -9,9 +9,13 @@ Matrix6d InverseCovariance(const Matrix6d& cov) { return cov.inverse(); }
 
 // Eq. 4.9: the difference of two covariances, kept positive definite.
 Matrix6d ClampedDifference(const Matrix6d& later, const Matrix6d& earlier) {
-  Eigen::SelfAdjointEigenSolver<Matrix6d> es(0.5 * ((later - earlier) + (later - earlier).transpose()));
-  const Vector6d ev = es.eigenvalues().cwiseMax(1e-10);
-  return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+  Vector6d ev;
+  Matrix6d V;
+  // Without convergence (non-finite input), the difference is not usable: the floor alone.
+  if (!SymmetricEigen(0.5 * ((later - earlier) + (later - earlier).transpose()), &ev, &V)) {
+    return Matrix6d::Identity() * 1e-10;
+  }
+  return V * ev.cwiseMax(1e-10).asDiagonal() * V.transpose();
 }
 
 }  // namespace

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 #include "estimation/so3.h"
+#include "estimation/symmetric_eigen.h"
 
 namespace cairn {
 namespace {
@@ -56,7 +56,7 @@ Eigen::Isometry3d AlignSe3(const std::vector<Eigen::Vector3d>& gt, const std::ve
     scatter += a * a.transpose();
   }
   // Singular values of the centred positions are the square roots of the scatter's eigenvalues.
-  const Eigen::Vector3d lambda = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues();
+  const Eigen::Vector3d lambda = SymmetricEigenvalues(scatter);
   const double s1 = std::sqrt(std::max(lambda(1), 0.0)), s0 = std::sqrt(std::max(lambda(2), 0.0));
   if (gt.size() < 3 || s1 < 1e-6 * std::max(1.0, s0)) return fallback;
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cross / n, Eigen::ComputeFullU | Eigen::ComputeFullV);

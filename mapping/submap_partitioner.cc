@@ -1,8 +1,9 @@
 #include "mapping/submap_partitioner.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+
+#include "estimation/symmetric_eigen.h"
 
 namespace cairn {
 
@@ -25,7 +26,7 @@ bool SubmapPartitioner::Update(Timestamp time, uint64_t frame_id, const Eigen::V
   // Largest standard deviation over all directions (covariance symmetrized first).
   const Eigen::Matrix3d sym = 0.5 * (cov + cov.transpose());
   const double sigma = sym.allFinite()
-                           ? std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(sym, Eigen::EigenvaluesOnly).eigenvalues().maxCoeff()))
+                           ? std::sqrt(std::max(0.0, SymmetricEigenvalues(sym).maxCoeff()))
                            : 0.0;
   const bool by_sigma = sigma > options_.max_position_sigma;
   const bool by_distance = distance_ > options_.max_distance;
