@@ -3,12 +3,12 @@
 // simulator's truth with a random initial error drawn from its covariance, truth errors in the
 // filter's error-state convention, and noisy relative-pose measurements.
 
+#include <limits>
 #include <random>
-
-#include <Eigen/Cholesky>
 
 #include "estimation/imu_simulator.h"
 #include "estimation/local_reference_filter.h"
+#include "estimation/small_cholesky.h"
 #include "estimation/so3.h"
 
 namespace cairn::testing {
@@ -43,7 +43,9 @@ inline ImuSample StartFromTruth(ImuSimulator& sim, LocalReferenceFilter& filter,
   std::normal_distribution<double> n(0.0, 1.0);
   Eigen::Matrix<double, 15, 1> z;
   for (int i = 0; i < 15; ++i) z[i] = n(rng);
-  const Eigen::Matrix<double, 15, 1> e = Eigen::LLT<Eigen::Matrix<double, 15, 15>>(P0).matrixL() * z;
+  Eigen::Matrix<double, 15, 15> L;
+  small_cholesky::Factor<15>(P0, &L);
+  const Eigen::Matrix<double, 15, 1> e = L * z;
   // Estimate = truth - error (error = truth - estimate; attitude: R_true = R_est Exp(e)).
   const Eigen::Quaterniond q = t.q * so3::ExpQuaternion(-e.segment<3>(kTheta));
   filter.Initialize(first.time, t.p - e.segment<3>(kP), t.v - e.segment<3>(kV), q,
@@ -64,7 +66,11 @@ inline Eigen::Matrix<double, 9, 1> StateError(const FilterState& s, const Eigen:
 
 inline double Nees(const FilterState& s, const Eigen::Matrix<double, 9, 1>& e) {
   const Eigen::Matrix<double, 9, 9> P = s.P.topLeftCorner<9, 9>();
-  return e.dot(P.ldlt().solve(e));
+  Eigen::Matrix<double, 9, 9> L;
+  if (!small_cholesky::Factor<9>(P, &L)) return std::numeric_limits<double>::infinity();
+  Eigen::Matrix<double, 9, 1> z = e;
+  small_cholesky::SolveLower<9>(L, z);
+  return z.squaredNorm();
 }
 
 // A relative pose between two truth poses, perturbed by noise drawn from `cov`.
@@ -73,7 +79,9 @@ inline Eigen::Isometry3d NoisyRelativePose(const TrajectoryPoint& a, const Traje
   std::normal_distribution<double> n(0.0, 1.0);
   Vector6d z;
   for (int i = 0; i < 6; ++i) z[i] = n(rng);
-  const Vector6d e = Eigen::LLT<Matrix6d>(cov).matrixL() * z;
+  Matrix6d L;
+  small_cholesky::Factor<6>(cov, &L);
+  const Vector6d e = L * z;
   const Eigen::Matrix3d Ra = a.q.toRotationMatrix();
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = (Ra.transpose() * b.q.toRotationMatrix()) * so3::Exp(e.tail<3>());

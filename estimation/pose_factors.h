@@ -126,8 +126,7 @@ struct AbsolutePoseResidual {
 };
 
 struct AbsolutePositionResidual {
-  AbsolutePositionResidual(const Eigen::Vector3d& z, const Eigen::Matrix3d& information)
-      : z_(z), sqrt_info(information.llt().matrixU()) {}
+  AbsolutePositionResidual(const Eigen::Vector3d& z, const Eigen::Matrix3d& information);
 
   template <class T>
   bool operator()(const T* p, T* out) const {
@@ -136,10 +135,8 @@ struct AbsolutePositionResidual {
     return true;
   }
 
-  static ceres::CostFunction* Create(const Eigen::Vector3d& z, const Eigen::Matrix3d& information) {
-    return new ceres::AutoDiffCostFunction<AbsolutePositionResidual, 3, 7>(
-        new AbsolutePositionResidual(z, information));
-  }
+  // Defined in the .cc: the autodiff cost function is instantiated once, not in every includer.
+  static ceres::CostFunction* Create(const Eigen::Vector3d& z, const Eigen::Matrix3d& information);
 
   Eigen::Vector3d z_;
   Eigen::Matrix3d sqrt_info;
