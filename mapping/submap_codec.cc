@@ -11,7 +11,6 @@
 #include "drivers/mcap/byte_reader.h"
 #include "drivers/mcap/byte_writer.h"
 #include "drivers/mcap/crc32.h"
-#include "mapping/voxel_hash_map.h"
 
 namespace cairn {
 namespace {
@@ -59,21 +58,22 @@ std::string TreeBinary(const octomap::OcTree& tree) {
 // voxels see similar texture, so the residuals compress about a quarter better than raw values.
 class ChannelPredictor {
  public:
-  ChannelPredictor(const Eigen::Vector3i& extent, size_t n)
-      : step_y_(static_cast<uint64_t>(extent.x())),
-        step_z_(static_cast<uint64_t>(extent.x()) * static_cast<uint64_t>(extent.y())), first_(n) {}
+  explicit ChannelPredictor(const Eigen::Vector3i& extent)
+      : steps_{1, static_cast<uint64_t>(extent.x()),
+               static_cast<uint64_t>(extent.x()) * static_cast<uint64_t>(extent.y())} {}
 
-  // The earlier points of the neighbour cells of `linear` (cell `d` in the extent); -1 when none.
-  void Neighbours(uint64_t linear, const int64_t d[3], int64_t out[3]) const {
-    const uint64_t steps[3] = {1, step_y_, step_z_};
+  // The first points of the neighbour cells of point i (cell `d` in the extent), -1 when none;
+  // keys[0..i] are the sorted voxel indices so far. The targets only grow with i, so one forward
+  // scan per axis finds them all (no lookup table).
+  void Neighbours(const std::vector<uint64_t>& keys, size_t i, const int64_t d[3], int64_t out[3]) {
     for (int a = 0; a < 3; ++a) {
-      const uint32_t* j = d[a] > 0 ? first_.Find(linear - steps[a]) : nullptr;
-      out[a] = j != nullptr ? static_cast<int64_t>(*j) : -1;
+      out[a] = -1;
+      if (d[a] == 0) continue;  // no neighbour inside the extent (x - 1 would wrap a row)
+      const uint64_t target = keys[i] - steps_[a];
+      size_t& j = next_[a];
+      while (j < i && keys[j] < target) ++j;
+      if (j < i && keys[j] == target) out[a] = static_cast<int64_t>(j);
     }
-  }
-  // Point i lies in cell `linear` (the first point of a cell is the one neighbours see).
-  void Add(uint64_t linear, uint32_t i) {
-    if (first_.Find(linear) == nullptr) first_[linear] = i;
   }
   static uint8_t Predict(const uint8_t* channel, const int64_t nb[3]) {
     int sum = 0, n = 0;
@@ -87,8 +87,8 @@ class ChannelPredictor {
   }
 
  private:
-  uint64_t step_y_, step_z_;
-  VoxelHashMap<uint32_t> first_;
+  uint64_t steps_[3];
+  size_t next_[3] = {0, 0, 0};
 };
 
 Status CheckOptions(const SubmapOptions& o) {
@@ -209,15 +209,16 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, McapCom
       values[2 * q.size() + i] = q[i].p->b;
     }
   }
-  ChannelPredictor predictor(extent, q.size());
+  ChannelPredictor predictor(extent);
+  std::vector<uint64_t> keys(q.size());
+  for (size_t i = 0; i < q.size(); ++i) keys[i] = q[i].linear;
   for (size_t i = 0; i < q.size(); ++i) {
     int64_t nb[3];
-    predictor.Neighbours(q[i].linear, q[i].d, nb);
+    predictor.Neighbours(keys, i, q[i].d, nb);
     for (int c = 0; c < channels; ++c) {
       const uint8_t* channel = values.data() + c * q.size();
       residuals[c * q.size() + i] = static_cast<uint8_t>(channel[i] - ChannelPredictor::Predict(channel, nb));
     }
-    predictor.Add(q[i].linear, static_cast<uint32_t>(i));
   }
   w.Bytes(residuals);
   std::vector<uint8_t> bits((q.size() + 7) / 8, 0);
@@ -316,7 +317,9 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   const double res = m.options.cloud_resolution;
   // The channels' residuals, turned into values in decoding order as the encoder predicted them.
   std::vector<uint8_t> values(coded.begin(), coded.end());
-  ChannelPredictor predictor(extent, n);
+  ChannelPredictor predictor(extent);
+  std::vector<uint64_t> decoded_keys;
+  decoded_keys.reserve(n);
   uint64_t linear = 0;
   for (uint32_t i = 0; i < n; ++i) {
     uint64_t d;
@@ -332,12 +335,12 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
     const double off[3] = {(xy[i] & 0xF) + 0.5, (xy[i] >> 4) + 0.5, z[i] + 0.5};
     const int64_t cell[3] = {x, y, zz};
     int64_t nb[3];
-    predictor.Neighbours(linear, cell, nb);
+    decoded_keys.push_back(linear);
+    predictor.Neighbours(decoded_keys, i, cell, nb);
     for (int c = 0; c < channels; ++c) {
       uint8_t* channel = values.data() + static_cast<size_t>(c) * n;
       channel[i] = static_cast<uint8_t>(channel[i] + ChannelPredictor::Predict(channel, nb));
     }
-    predictor.Add(linear, i);
     CloudPoint& p = pts[i];
     p.p = Eigen::Vector3f(static_cast<float>((lo.x() + x + off[0] / kOffsetSteps) * res),
                           static_cast<float>((lo.y() + y + off[1] / kOffsetSteps) * res),
