@@ -136,9 +136,11 @@ void MapComposer::Contribute(const octomap::OcTree& tree, const std::vector<Clou
       touched_.clear();
     }
   }
+  // Sampling works in global voxel units (g = R c + t / res with c in source voxels): no scaling
+  // per sample, and the rotated sample offsets and voxel steps are computed once.
   const auto add = [&](const Eigen::Vector3f& g, float value) {
+    const Eigen::Vector3f f = g.array().floor();
     if (dense) {
-      const Eigen::Vector3f f = (g * inv).array().floor();
       const int x = static_cast<int>(f.x()) - g0.x(), y = static_cast<int>(f.y()) - g0.y(), z = static_cast<int>(f.z()) - g0.z();
       if (x >= 0 && y >= 0 && z >= 0 && x < dims.x() && y < dims.y() && z < dims.z()) {
         const uint32_t i = static_cast<uint32_t>((z * dims.y() + y) * dims.x() + x);
@@ -150,31 +152,32 @@ void MapComposer::Contribute(const octomap::OcTree& tree, const std::vector<Clou
       }
     }
     uint64_t key;
-    if (!VoxelKey::Of(g, inv, &key)) return;
+    if (!VoxelKey::Of(f, 1.0f, &key)) return;
     Occ& o = resample_[key];
     o.sum += value;
     ++o.n;
   };
-  const float fres = static_cast<float>(res);
+  const Eigen::Vector3f tv = t * inv;
+  const Eigen::Vector3f step_x = R.col(0), step_y = R.col(1), step_z = R.col(2);
+  Eigen::Vector3f sample[8];
+  const int n_samples = aligned ? 1 : samples;
+  for (int si = 0; si < n_samples; ++si) {
+    // The 8-sample set: the z = -1/4 layer above plus the same x-y pattern at z = +1/4.
+    Eigen::Vector3f off = aligned ? Eigen::Vector3f::Zero() : offsets[si];
+    if (samples == 8 && si < 4) off.z() = 0.25f;
+    sample[si] = R * off;
+  }
   for (const Leaf& leaf : leaves_) {
     const float value = leaf.value;
     const int cells = leaf.cells;
+    const Eigen::Vector3f base = R * (leaf.min.cast<float>() + Eigen::Vector3f::Constant(0.5f)) + tv;
     for (int dz = 0; dz < cells; ++dz) {
+      const Eigen::Vector3f pz = base + static_cast<float>(dz) * step_z;
       for (int dy = 0; dy < cells; ++dy) {
+        const Eigen::Vector3f py = pz + static_cast<float>(dy) * step_y;
         for (int dx = 0; dx < cells; ++dx) {
-          const Eigen::Vector3f c((leaf.min.x() + dx + 0.5f) * fres, (leaf.min.y() + dy + 0.5f) * fres,
-                                  (leaf.min.z() + dz + 0.5f) * fres);
-          const Eigen::Vector3f g = R * c + t;
-          if (aligned) {
-            add(g, value);
-            continue;
-          }
-          for (int si = 0; si < samples; ++si) {
-            // The 8-sample set: the z = -1/4 layer above plus the same x-y pattern at z = +1/4.
-            Eigen::Vector3f off = offsets[si];
-            if (samples == 8 && si < 4) off.z() = 0.25f;
-            add(g + R * (off * fres), value);
-          }
+          const Eigen::Vector3f g = py + static_cast<float>(dx) * step_x;
+          for (int si = 0; si < n_samples; ++si) add(g + sample[si], value);
         }
       }
     }
@@ -229,7 +232,7 @@ CompositionStats MapComposer::Update() {
   if (open_ != nullptr) {
     // The open tree's inner nodes are stale (lazy updates), but only leaves are read.
     Contribute(open_->tree(), open_->cloud().Points(), open_pose_, &open_points_, &open_pairs_);
-    for (const CloudPoint& p : open_points_) open_cloud_.Add(p);
+    open_cloud_.AddAll(open_points_, 1);
     for (const auto& [key, value] : open_pairs_) open_occupancy_[key] = value;
   }
   // Counted as contributions come and go: a scan of the global table would cost more than an

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +54,62 @@ TEST(SubmapCodecTest, RoundTripKeepsMetadataQuantizedCloudAndOccupancy) {
   }
 }
 
+// Version 2 codes colour as residuals of a neighbour prediction: still exact. Two points in one
+// voxel (a centroid rounded onto the next voxel's boundary) both come back.
+TEST(SubmapCodecTest, ColourAndSharedVoxelsRoundTripExactly) {
+  SubmapMetadata m;
+  m.robot = "hexacopter";
+  m.id = 2;
+  std::vector<CloudPoint> pts;
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> u8(0, 255);
+  const float res = 0.05f;
+  for (int x = 0; x < 40; ++x) {
+    for (int y = 0; y < 30; ++y) {
+      for (int z = 0; z < 3; ++z) {
+        if ((x * 7 + y * 3 + z) % 5 == 0) continue;  // holes: not every neighbour exists
+        CloudPoint p;
+        p.p = Eigen::Vector3f((x + 0.3f) * res, (y - 20 + 0.7f) * res, (z + 0.5f) * res);
+        p.r = static_cast<uint8_t>(u8(rng));
+        p.g = static_cast<uint8_t>(x * 6);
+        p.b = static_cast<uint8_t>(255 - y * 8);
+        p.obstacle = z == 2;
+        pts.push_back(p);
+      }
+    }
+  }
+  CloudPoint twin = pts[10];
+  twin.p.z() += 0.2f * res;
+  twin.r ^= 0x55;
+  pts.push_back(twin);
+  const Submap submap(m, pts, MakeOccupancyTree(m.options));
+  auto bytes = SubmapCodec::Encode(submap);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
+  auto back = SubmapCodec::Decode(*bytes);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  ASSERT_EQ((*back)->points().size(), pts.size());
+  // Decoded in index order: match each original to the decoded point nearest to it.
+  std::vector<bool> used((*back)->points().size(), false);
+  for (const CloudPoint& p : pts) {
+    size_t best = 0;
+    float best_d = 1e9f;
+    for (size_t j = 0; j < (*back)->points().size(); ++j) {
+      const CloudPoint& q = (*back)->points()[j];
+      const float d = (q.p - p.p).cwiseAbs().maxCoeff();
+      if (!used[j] && d < best_d && q.r == p.r) {
+        best_d = d;
+        best = j;
+      }
+    }
+    ASSERT_LE(best_d, res / 32 + 1e-5f);
+    const CloudPoint& q = (*back)->points()[best];
+    used[best] = true;
+    EXPECT_EQ(q.g, p.g);
+    EXPECT_EQ(q.b, p.b);
+    EXPECT_EQ(q.obstacle, p.obstacle);
+  }
+}
+
 TEST(SubmapCodecTest, RejectsCorruptInputWithAClearError) {
   const auto submap = testing::SyntheticSubmap(3, 1);
   auto bytes = SubmapCodec::Encode(*submap);
@@ -78,6 +135,8 @@ TEST(SubmapCodecTest, RejectsCorruptInputWithAClearError) {
   bad = good;
   bad[8] = 9;  // version
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version"), std::string::npos);
+  bad[8] = 1;  // the previous format (raw channels) is not read as this one
+  EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version 1 is not supported"), std::string::npos);
   bad = good;
   bad.back() ^= 1;
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("checksum"), std::string::npos);

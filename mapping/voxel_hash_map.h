@@ -11,6 +11,8 @@
 
 #include <Eigen/Core>
 
+#include "mapping/huge_page_allocator.h"
+
 namespace cairn {
 
 // Three signed 21-bit cell indices packed into 63 bits (x lowest). At 0.05 m a key spans +-52 km.
@@ -119,7 +121,7 @@ class VoxelHashMap {
     return static_cast<size_t>(k);
   }
   void Rehash(size_t capacity) {
-    std::vector<Slot> old;
+    std::vector<Slot, HugePageAllocator<Slot>> old;
     old.swap(slots_);
     slots_.assign(capacity, Slot{});
     mask_ = capacity - 1;
@@ -129,7 +131,7 @@ class VoxelHashMap {
     }
   }
 
-  std::vector<Slot> slots_;
+  std::vector<Slot, HugePageAllocator<Slot>> slots_;
   size_t mask_ = 0;
   size_t size_ = 0;
 };

@@ -23,15 +23,15 @@ Expected<McapCompression> ChunkCodec::FromName(std::string_view name) {
   return DataLossError("unsupported chunk compression '" + std::string(name) + "'");
 }
 
-Status ChunkCodec::Compress(McapCompression c, std::span<const uint8_t> in, std::vector<uint8_t>* out) {
+Status ChunkCodec::Compress(McapCompression c, std::span<const uint8_t> in, std::vector<uint8_t>* out,
+                            int zstd_level) {
   switch (c) {
     case McapCompression::kNone:
       out->assign(in.begin(), in.end());
       return Status::Ok();
     case McapCompression::kZstd: {
       out->resize(ZSTD_compressBound(in.size()));
-      // Level 1: recording must keep up with stereo images on a robot's CPU.
-      const size_t n = ZSTD_compress(out->data(), out->size(), in.data(), in.size(), 1);
+      const size_t n = ZSTD_compress(out->data(), out->size(), in.data(), in.size(), zstd_level);
       if (ZSTD_isError(n)) return InternalError(std::string("zstd: ") + ZSTD_getErrorName(n));
       out->resize(n);
       return Status::Ok();

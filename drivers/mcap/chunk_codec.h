@@ -18,8 +18,10 @@ class ChunkCodec {
   static std::string_view Name(McapCompression c);
   static Expected<McapCompression> FromName(std::string_view name);
 
-  // Replaces `out` with the compressed bytes (kept allocated across calls).
-  static Status Compress(McapCompression c, std::span<const uint8_t> in, std::vector<uint8_t>* out);
+  // Replaces `out` with the compressed bytes (kept allocated across calls). `zstd_level` trades
+  // speed for size (1: recordings, which must keep up with the sensors).
+  static Status Compress(McapCompression c, std::span<const uint8_t> in, std::vector<uint8_t>* out,
+                         int zstd_level = 1);
   // Decompresses into exactly `uncompressed_size` bytes or fails.
   static Status Decompress(McapCompression c, std::span<const uint8_t> in,
                            uint64_t uncompressed_size, std::vector<uint8_t>* out);
