@@ -19,8 +19,9 @@ constexpr char kMagic[8] = {'C', 'A', 'I', 'R', 'N', 'S', 'U', 'B'};
 constexpr uint64_t kMaxPayload = uint64_t{1} << 30;
 constexpr int kOffsetSteps = 16;
 constexpr int kTreeDepth = 16;
-// zstd level of the body: a submap is encoded once every few seconds, sent over a poor radio link.
-constexpr int kZstdLevel = 9;
+// zstd level of the body: a submap is sent over a poor radio link, but it is encoded on the mapping
+// thread, where level 9 took up to 0.4 s for a hexacopter submap for about 2 % less size.
+constexpr int kZstdLevel = 3;
 
 void F64(ByteWriter& w, double v) { w.U64(std::bit_cast<uint64_t>(v)); }
 double F64(ByteReader& r) { return std::bit_cast<double>(r.U64()); }
