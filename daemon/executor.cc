@@ -1,5 +1,7 @@
 #include "daemon/executor.h"
 
+#include "hal/sanitizers.h"
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -22,7 +24,7 @@ Executor::Executor(std::string name, ExecutorOptions options)
 Executor::~Executor() { Join(); }
 
 bool Executor::LockProcessMemory(std::string* why_not) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if CAIRN_ADDRESS_SANITIZER || CAIRN_THREAD_SANITIZER
   // Sanitizers reserve terabytes of shadow memory; locking it would exhaust the machine.
   *why_not = "mlockall skipped in a sanitizer build";
   return false;

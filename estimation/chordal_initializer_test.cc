@@ -8,6 +8,7 @@
 
 #include "estimation/g2o_io.h"
 #include "estimation/so3.h"
+#include "tests/support/test_data.h"
 
 namespace cairn {
 namespace {
@@ -40,8 +41,7 @@ TEST(ChordalInitializerTest, RecoversNoiseFreePosesFromGarbageEstimates) {
 }
 
 TEST(ChordalInitializerTest, BeatsOdometryOnIntel) {
-  const char* dir = std::getenv("CAIRN_DATA_DIR");
-  const std::string path = std::string(dir ? dir : "") + "/posegraphs/intel.g2o";
+  const std::string path = cairn::testing::DataDir() + "/posegraphs/intel.g2o";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "missing " << path;
   auto g = ReadG2o(path);
   ASSERT_TRUE(g.ok());

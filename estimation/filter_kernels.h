@@ -5,6 +5,8 @@
 // vectorize on every target (SSE2, NEON) without ISA-specific flags; on x86-64 the main ones are
 // also built for AVX2 and picked at load time.
 
+#include "hal/sanitizers.h"
+
 namespace cairn::kernels {
 
 // Two and four doubles (the latter lowered to pairs of two-double operations where AVX2 is not
@@ -23,7 +25,7 @@ template <> struct Unaligned<4> { using type = V4u; };
 // ThreadSanitizer builds go without: the loader runs the resolvers before the sanitizer's runtime
 // is set up, and the instrumented resolvers crash (as in drivers/simulator/simd_clones.h).
 #if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_THREAD__)
+    !CAIRN_THREAD_SANITIZER
 #define CAIRN_WIDE_KERNEL __attribute__((target_clones("avx2", "default")))
 #else
 #define CAIRN_WIDE_KERNEL

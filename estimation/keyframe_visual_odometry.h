@@ -94,7 +94,6 @@ class KeyframeVisualOdometry {
   StereoPyramids current_;
   Eigen::Isometry3d T_odom_cam_ = Eigen::Isometry3d::Identity();  // last estimate
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();    // T_prev_cur of the last step
-  bool have_pose_ = false;
   int64_t consecutive_failures_ = 0;
   uint64_t frames_ = 0;
   // Scratch.

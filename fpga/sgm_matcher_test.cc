@@ -21,6 +21,7 @@
 #include "fpga/stereo_depth.h"
 #include "fpga/stereo_image_io.h"
 #include "mapping/stereo_error_model.h"
+#include "tests/support/test_data.h"
 
 namespace cairn {
 namespace {
@@ -92,11 +93,6 @@ void MakePair(int w, int h, F disparity, std::vector<uint8_t>* l, std::vector<ui
       (*r)[static_cast<size_t>(y) * w + x] = static_cast<uint8_t>(std::lround(tex.At(xl, y)));
     }
   }
-}
-
-std::string DataDir() {
-  const char* d = std::getenv("CAIRN_DATA_DIR");
-  return d != nullptr ? d : "";
 }
 
 // Every SIMD target this machine can run that the kernels are compiled for (fpga/CMakeLists.txt
@@ -183,7 +179,7 @@ TEST(SgmMatcherTest, ScalarEqualsSimdOnRandomImagesForEveryTarget) {
 }
 
 TEST(SgmMatcherTest, ScalarEqualsSimdOnRealImages) {
-  const std::string dir = DataDir() + "/stereo/middlebury2003-cones";
+  const std::string dir = testing::DataDir() + "/stereo/middlebury2003-cones";
   if (!std::filesystem::exists(dir + "/im2.png")) GTEST_SKIP() << "missing " << dir;
   auto pair = LoadGrayPair(dir + "/im2.png", dir + "/im6.png");
   ASSERT_TRUE(pair.ok());
@@ -475,7 +471,7 @@ TEST(SgmMatcherTest, BeatsOpenCvOnMiddlebury) {
       {"middlebury2014q-motorcycle", "im0.png", "im1.png", "disp0GT.pfm", 0.0, "mask0nocc.png", 80,
        DisparityMetric::kBad05}};
   for (const MiddleburyCase& c : cases) {
-    const std::string dir = DataDir() + "/stereo/" + c.folder;
+    const std::string dir = testing::DataDir() + "/stereo/" + c.folder;
     if (!std::filesystem::exists(dir + "/" + c.left)) GTEST_SKIP() << "missing " << dir;
     auto pair = LoadGrayPair(dir + "/" + c.left, dir + "/" + c.right);
     ASSERT_TRUE(pair.ok());

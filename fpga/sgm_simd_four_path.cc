@@ -376,9 +376,9 @@ HWY_INLINE hn::Vec<D> SecondVisit(D d, const RowArgs& a, int x, const uint8_t* h
       }
     }
     // s[-1] and s[dc] are readable (scratch around the sums).
-    const size_t near = size_t{static_cast<uint32_t>(s[bk]) < t} +
-                        size_t{(bk > 0) & (static_cast<uint32_t>(s[bk - 1]) < t)} +
-                        size_t{(bk + 1 < dc) & (static_cast<uint32_t>(s[bk + 1]) < t)};
+    const size_t near = static_cast<size_t>(static_cast<uint32_t>(s[bk]) < t) +
+                        static_cast<size_t>(bk > 0 && static_cast<uint32_t>(s[bk - 1]) < t) +
+                        static_cast<size_t>(bk + 1 < dc && static_cast<uint32_t>(s[bk + 1]) < t);
     unique = below == near;
   }
   a.best[x] = static_cast<int16_t>(unique ? bk : -1 - bk);

@@ -9,6 +9,7 @@
 
 #include "drivers/euroc_dataset.h"
 #include "fpga/sgm_matcher.h"
+#include "tests/support/test_data.h"
 
 namespace cairn {
 namespace {
@@ -64,8 +65,7 @@ TEST(StereoRectifierTest, RejectsBadCalibrationAndImages) {
 // Real EuRoC pair: after rectification SGM finds a dense, plausible disparity field (the scene
 // is a room 2 to 6 m away: with f ~ 460 px and b = 0.11 m that is about 8 to 25 px).
 TEST(StereoRectifierTest, RectifiedEurocPairMatches) {
-  const char* env = std::getenv("CAIRN_DATA_DIR");
-  const std::string root = std::string(env != nullptr ? env : "") + "/euroc-v1_01-micro";
+  const std::string root = cairn::testing::EurocMicro();
   if (!std::filesystem::exists(root + "/mav0")) GTEST_SKIP() << "missing " << root;
   auto ds = EurocDataset::Open(root);
   ASSERT_TRUE(ds.ok()) << ds.status().ToString();

@@ -77,7 +77,7 @@ std::unique_ptr<octomap::OcTree> MakeOccupancyTree(const SubmapOptions& o) {
   return tree;
 }
 
-OccupancyIntegrator::OccupancyIntegrator(double resolution, double max_distance) : res_(resolution) {
+OccupancyIntegrator::OccupancyIntegrator(double resolution, double max_distance) {
   side_ = 2 * static_cast<int>(std::ceil(max_distance / resolution)) + 4;
   stamps_.assign(static_cast<size_t>(side_) * static_cast<size_t>(side_) * static_cast<size_t>(side_), 0);
 }

@@ -40,7 +40,6 @@ class OccupancyIntegrator {
  private:
   uint32_t& Stamp(const octomap::OcTreeKey& k);
 
-  double res_;
   int side_ = 0;
   octomap::OcTreeKey centre_;
   std::vector<uint32_t> stamps_;

@@ -1,4 +1,7 @@
 #pragma once
+
+#include "hal/sanitizers.h"
+
 // CAIRN_SIM_CLONES marks the simulator's hot loops for compilation twice, for the x86-64 baseline
 // (SSE2) and for AVX2, the dynamic loader picking the version the CPU runs. "avx2" does not enable
 // fused multiply-add, so both versions perform the same IEEE operations in the same order and
@@ -10,7 +13,7 @@
 // the instrumented resolvers crash.
 
 #if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) && \
-    !defined(__SANITIZE_THREAD__)
+    !CAIRN_THREAD_SANITIZER
 #define CAIRN_SIM_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define CAIRN_SIM_CLONES

@@ -543,7 +543,7 @@ CAIRN_SIM_CLONES void HitStartCells(int count, double oz, const double* __restri
     const bool ok1 = (th1 >= lo[i]) & (th1 <= hi[i]) & (th1 > 0.0) & (u1 >= -kTol) & (u1 <= 1 + kTol) &
                      (v1 >= -kTol) & (v1 <= 1 + kTol) & (v1 - u1 >= -kTol);
     const bool pick1 = ok1 & (!ok0 | (th1 < th0));
-    hit[i] = ok0 | ok1 ? 1.0 : 0.0;
+    hit[i] = (ok0 | ok1) ? 1.0 : 0.0;
     th_best[i] = pick1 ? th1 : th0;
     a_best[i] = pick1 ? a1 : a0;
     b_best[i] = pick1 ? b1 : b0;
