@@ -8,7 +8,6 @@ namespace cairn {
 namespace {
 
 using RowJacobian6 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
-using RowJacobian12 = Eigen::Matrix<double, 12, 7, Eigen::RowMajor>;
 
 Eigen::Quaterniond QuaternionOf(const double* p) { return Eigen::Quaterniond(p[6], p[3], p[4], p[5]); }
 
@@ -68,33 +67,38 @@ bool RelativePoseCost::Evaluate(double const* const* parameters, double* residua
 }
 
 ChordalCost::ChordalCost(const Pose3& T_i_j, double kappa, double tau)
-    : R_ij_(T_i_j.R()), t_ij_(T_i_j.t), sqrt_kappa_(std::sqrt(kappa)), sqrt_tau_(std::sqrt(tau)) {}
+    : t_ij_(T_i_j.t), q_ji_(T_i_j.q.conjugate()), sqrt_8kappa_(std::sqrt(8.0 * kappa)), sqrt_tau_(std::sqrt(tau)) {}
 
 bool ChordalCost::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   const double* pi = parameters[0];
   const double* pj = parameters[1];
-  const Eigen::Matrix3d Ri = QuaternionOf(pi).normalized().toRotationMatrix();
-  const Eigen::Matrix3d Rj = QuaternionOf(pj).normalized().toRotationMatrix();
-  const Eigen::Vector3d Rt = Ri * t_ij_;
-  const Eigen::Matrix3d M = Ri * R_ij_;
-  const Eigen::Vector3d et = Eigen::Vector3d(pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]) - Rt;
-  const Eigen::Matrix3d eR = Rj - M;
-  for (int k = 0; k < 3; ++k) residuals[k] = sqrt_tau_ * et[k];
-  for (int k = 0; k < 9; ++k) residuals[3 + k] = sqrt_kappa_ * eR(k % 3, k / 3);
+  const Eigen::Quaterniond qi = QuaternionOf(pi).normalized(), qj = QuaternionOf(pj).normalized();
+  const Eigen::Vector3d d = Eigen::Vector3d(pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]);
+  const Eigen::Matrix3d Ri_T = qi.conjugate().toRotationMatrix();
+  Eigen::Quaterniond qe = q_ji_ * qi.conjugate() * qj;
+  if (qe.w() < 0.0) qe.coeffs() = -qe.coeffs();
+  Eigen::Map<Vector6d> r(residuals);
+  r.head<3>() = sqrt_tau_ * (Ri_T * d - t_ij_);
+  r.tail<3>() = sqrt_8kappa_ * qe.vec();
   if (jacobians == nullptr) return true;
-  // Exp(phi) R c = R c - [R c]x phi for each column c.
+  // Left perturbations t' = t + dt, R' = Exp(phi) R:
+  //   dr_t/dt_j = -dr_t/dt_i = R_i^T, dr_t/dphi_i = R_i^T [d]x;
+  //   q_e' = q_e * exp(R_j^T (phi_j - phi_i) / 2), so dr_R/dphi_j = -dr_R/dphi_i = (w I + [v]x) R_j^T / 2.
+  const Eigen::Matrix3d A = sqrt_tau_ * Ri_T;
+  const Eigen::Matrix3d B = (0.5 * sqrt_8kappa_) * (qe.w() * Eigen::Matrix3d::Identity() + so3::Skew(qe.vec())) *
+                            qj.conjugate().toRotationMatrix();
   if (jacobians[0] != nullptr) {
-    Eigen::Matrix<double, 12, 6> J = Eigen::Matrix<double, 12, 6>::Zero();
-    J.topLeftCorner<3, 3>() = -sqrt_tau_ * Eigen::Matrix3d::Identity();
-    J.topRightCorner<3, 3>() = sqrt_tau_ * so3::Skew(Rt);
-    for (int c = 0; c < 3; ++c) J.block<3, 3>(3 + 3 * c, 3) = sqrt_kappa_ * so3::Skew(M.col(c));
-    ToAmbient<12>(J, pi, jacobians[0]);
+    Matrix6d J = Matrix6d::Zero();
+    J.topLeftCorner<3, 3>() = -A;
+    J.topRightCorner<3, 3>() = A * so3::Skew(d);
+    J.bottomRightCorner<3, 3>() = -B;
+    ToAmbient<6>(J, pi, jacobians[0]);
   }
   if (jacobians[1] != nullptr) {
-    Eigen::Matrix<double, 12, 6> J = Eigen::Matrix<double, 12, 6>::Zero();
-    J.topLeftCorner<3, 3>() = sqrt_tau_ * Eigen::Matrix3d::Identity();
-    for (int c = 0; c < 3; ++c) J.block<3, 3>(3 + 3 * c, 3) = -sqrt_kappa_ * so3::Skew(Rj.col(c));
-    ToAmbient<12>(J, pj, jacobians[1]);
+    Matrix6d J = Matrix6d::Zero();
+    J.topLeftCorner<3, 3>() = A;
+    J.bottomRightCorner<3, 3>() = B;
+    ToAmbient<6>(J, pj, jacobians[1]);
   }
   return true;
 }

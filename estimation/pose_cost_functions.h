@@ -26,16 +26,17 @@ class RelativePoseCost final : public ceres::SizedCostFunction<6, 7, 7> {
   Matrix6d sqrt_info_;
 };
 
-// r = [sqrt(tau)(t_j - t_i - R_i t_ij); sqrt(kappa) vec(R_j - R_i R_ij)] (column-major vec).
-class ChordalCost final : public ceres::SizedCostFunction<12, 7, 7> {
+// r = [sqrt(tau) (R_i^T (t_j - t_i) - t_ij); sqrt(8 kappa) vec(q_ij^-1 q_i^-1 q_j)] (w >= 0), whose
+// squared norm is the SE-Sync term (see ChordalResidual).
+class ChordalCost final : public ceres::SizedCostFunction<6, 7, 7> {
  public:
   ChordalCost(const Pose3& T_i_j, double kappa, double tau);
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 
  private:
-  Eigen::Matrix3d R_ij_;
   Eigen::Vector3d t_ij_;
-  double sqrt_kappa_, sqrt_tau_;
+  Eigen::Quaterniond q_ji_;
+  double sqrt_8kappa_, sqrt_tau_;
 };
 
 // r = S [R_z^T (t - t_z); Log(R_z^T R)].

@@ -105,7 +105,7 @@ TEST(PoseFactorsTest, AnalyticCostsEqualAutodiffOfTheReferenceFunctors) {
     ceres::AutoDiffCostFunction<RelativePoseResidual, 6, 7, 7> rel_ref(new RelativePoseResidual(z, info));
     ExpectSameCost(*rel, rel_ref, {a, b});
     std::unique_ptr<ceres::CostFunction> chordal(ChordalResidual::Create(z, 3.0, 7.0));
-    ceres::AutoDiffCostFunction<ChordalResidual, 12, 7, 7> chordal_ref(new ChordalResidual(z, 3.0, 7.0));
+    ceres::AutoDiffCostFunction<ChordalResidual, 6, 7, 7> chordal_ref(new ChordalResidual(z, 3.0, 7.0));
     ExpectSameCost(*chordal, chordal_ref, {a, b});
     std::unique_ptr<ceres::CostFunction> abs(AbsolutePoseResidual::Create(a.Inverse() * b, info));
     ceres::AutoDiffCostFunction<AbsolutePoseResidual, 6, 7> abs_ref(new AbsolutePoseResidual(a.Inverse() * b, info));
@@ -150,7 +150,7 @@ TEST(PoseFactorsTest, ChordalResidualIsTheSeSyncTerm) {
     PoseToBlock(a, pa);
     PoseToBlock(b, pb);
     const double* params[] = {pa, pb};
-    Eigen::Matrix<double, 12, 1> r;
+    Vector6d r;
     ASSERT_TRUE(cost->Evaluate(params, r.data(), nullptr));
     const double expected = 3.0 * (b.R() - a.R() * z.R()).squaredNorm() + 7.0 * (b.t - a.t - a.R() * z.t).squaredNorm();
     EXPECT_NEAR(r.squaredNorm(), expected, 1e-9 * expected);

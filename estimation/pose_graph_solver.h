@@ -30,8 +30,9 @@ struct PoseGraphSolverOptions {
   // Levenberg-Marquardt iterations per GNC round: each round only tracks the changed weights.
   int64_t gnc_round_iterations = 10;
   // Relative cost change that ends the solve; 0 = per objective: 1e-10 for the geodesic one
-  // (quadratic convergence, one more iteration at most), 1e-6 for SE-Sync's (Gauss-Newton
-  // converges only linearly on its large residuals; 1e-6 leaves ~3e-6 relative to the optimum).
+  // (quadratic convergence, one more iteration at most), 1e-6 for SE-Sync's (2-3 iterations on
+  // four of the five standard graphs; parking-garage converges linearly and needs 24 iterations
+  // for 6e-6 relative to its optimum, 93 for 1e-10).
   double function_tolerance = 0.0;
   int64_t threads = 1;
   bool verbose = false;  // Ceres progress and report on stderr
