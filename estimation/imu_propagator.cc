@@ -65,11 +65,24 @@ CAIRN_WIDE_KERNEL void ApplyTransitionT(const Transition& f, double* m, int ld) 
   if constexpr (Rows % 2 == 1) TransitionRow<1>(f, m, ld, i);
 }
 
+// The same for a run of `rows` rows (several clone cross blocks in adjacent slots at once).
+CAIRN_WIDE_KERNEL void ApplyTransitionRowsT(const Transition& f, double* m, int ld, int rows) {
+  int i = 0;
+  for (; i + 4 <= rows; i += 4) TransitionRow<4>(f, m, ld, i);
+  for (; i + 2 <= rows; i += 2) TransitionRow<2>(f, m, ld, i);
+  for (; i < rows; ++i) TransitionRow<1>(f, m, ld, i);
+}
+
 // Jr(phi) from the rotation's half-angle sine and cosine (no further trigonometry).
 Eigen::Matrix3d RightJacobianFromHalfAngle(const Eigen::Vector3d& phi, double s_half, double c_half) {
   const double theta2 = phi.squaredNorm();
   const Eigen::Matrix3d W = so3::Skew(phi);
-  if (theta2 < 1e-10) return Eigen::Matrix3d::Identity() - 0.5 * W + W * W / 6.0;
+  if (theta2 < 1e-4) {
+    // Series to the terms below double precision (no cancellation, no division).
+    const double a = 0.5 - theta2 / 24.0 * (1.0 - theta2 / 30.0 * (1.0 - theta2 / 56.0));
+    const double b = 1.0 / 6.0 - theta2 / 120.0 * (1.0 - theta2 / 42.0 * (1.0 - theta2 / 72.0));
+    return Eigen::Matrix3d::Identity() - a * W + b * W * W;
+  }
   const double theta = std::sqrt(theta2);
   const double one_minus_cos = 2.0 * s_half * s_half;
   const double sin_theta = 2.0 * s_half * c_half;
@@ -94,9 +107,9 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   const Eigen::Vector3d a1 = accel1 - s.ba;
   const Eigen::Matrix3d R0 = s.q.toRotationMatrix();
   const Eigen::Vector3d phi = w * dt;
-  const Eigen::Quaterniond dq = so3::ExpQuaternion(phi);
+  const Eigen::Quaterniond dq = so3::ExpQuaternionSmall(phi);
   const Eigen::Quaterniond q0 = s.q;
-  const Eigen::Quaterniond q1 = (q0 * dq).normalized();
+  const Eigen::Quaterniond q1 = so3::Normalized(q0 * dq);
   const Eigen::Matrix3d R1 = q1.toRotationMatrix();
   const Eigen::Vector3d acc_world = 0.5 * (R0 * a0 + R1 * a1) + gravity_;
   s.p += s.v * dt + 0.5 * acc_world * dt * dt;
@@ -110,7 +123,7 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   const double c_quarter = std::sqrt(0.5 * (1.0 + c_half));
   const Eigen::Quaterniond dq_mid(c_quarter, 0.5 / c_quarter * dq.x(), 0.5 / c_quarter * dq.y(),
                                   0.5 / c_quarter * dq.z());
-  const Eigen::Matrix3d R_mid = (q0 * dq_mid).normalized().toRotationMatrix();
+  const Eigen::Matrix3d R_mid = so3::Normalized(q0 * dq_mid).toRotationMatrix();
   Transition f;
   f.dt = dt;
   f.a = 0.5 * (a0 + a1);
@@ -149,12 +162,22 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
 
   // Cross-covariance with the clones: X <- Phi X, deferred in phi (phi <- Phi phi; phi is
   // row-major, so its storage is phi^T) except for the clones whose cross block is kept current
-  // (stored transposed, B_j <- B_j Phi^T).
+  // (stored transposed, B_j <- B_j Phi^T); the blocks of adjacent slots are adjacent rows, one
+  // run each.
   ApplyTransitionT<kCoreDim>(f, s.phi.data(), kCoreDim);
-  for (int j = 0; j < kMaxClones; ++j) {
+  auto current = [&s](int j) {
     const size_t u = static_cast<size_t>(j);
-    if (s.clones[u].id == kNoClone || !s.cross_current[u]) continue;
-    ApplyTransitionT<6>(f, &s.P(CloneIndex(j), 0), kStateDim);
+    return s.clones[u].id != kNoClone && s.cross_current[u];
+  };
+  for (int j = 0; j < kMaxClones;) {
+    if (!current(j)) {
+      ++j;
+      continue;
+    }
+    int end = j + 1;
+    while (end < kMaxClones && current(end)) ++end;
+    ApplyTransitionRowsT(f, &s.P(CloneIndex(j), 0), kStateDim, 6 * (end - j));
+    j = end;
   }
   MarkDeferred(s);
 
