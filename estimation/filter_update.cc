@@ -37,6 +37,7 @@ template <int M>
 UpdateOutcome CoreUpdate(FilterState& s, const Eigen::Matrix<double, M, kCoreDim>& H,
                          const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<double, M, M>& R,
                          double gate) {
+  FlushTransition(s);
   const CoreMatrix Pc = s.P.topLeftCorner<kCoreDim, kCoreDim>();
   Eigen::Matrix<double, kCoreDim, M> W = Pc.lazyProduct(H.transpose());  // P H^T, then W_core
   Eigen::Matrix<double, M, M> S = H.lazyProduct(W) + R;

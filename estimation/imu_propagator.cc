@@ -65,14 +65,6 @@ CAIRN_WIDE_KERNEL void ApplyTransitionT(const Transition& f, double* m, int ld) 
   if constexpr (Rows % 2 == 1) TransitionRow<1>(f, m, ld, i);
 }
 
-// The same for a run of `rows` rows (several clone cross blocks in adjacent slots at once).
-CAIRN_WIDE_KERNEL void ApplyTransitionRowsT(const Transition& f, double* m, int ld, int rows) {
-  int i = 0;
-  for (; i + 4 <= rows; i += 4) TransitionRow<4>(f, m, ld, i);
-  for (; i + 2 <= rows; i += 2) TransitionRow<2>(f, m, ld, i);
-  for (; i < rows; ++i) TransitionRow<1>(f, m, ld, i);
-}
-
 // Jr(phi) from the rotation's half-angle sine and cosine (no further trigonometry).
 Eigen::Matrix3d RightJacobianFromHalfAngle(const Eigen::Vector3d& phi, double s_half, double c_half) {
   const double theta2 = phi.squaredNorm();
@@ -160,25 +152,23 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   s.P.block<3, 3>(kBa, kBa).diagonal().array() += qba * dt;
   s.P.block<3, 3>(kBg, kBg).diagonal().array() += qbg * dt;
 
-  // Cross-covariance with the clones: X <- Phi X, deferred in phi (phi <- Phi phi; phi is
-  // row-major, so its storage is phi^T) except for the clones whose cross block is kept current
-  // (stored transposed, B_j <- B_j Phi^T); the blocks of adjacent slots are adjacent rows, one
-  // run each.
-  ApplyTransitionT<kCoreDim>(f, s.phi.data(), kCoreDim);
-  auto current = [&s](int j) {
-    const size_t u = static_cast<size_t>(j);
-    return s.clones[u].id != kNoClone && s.cross_current[u];
-  };
-  for (int j = 0; j < kMaxClones;) {
-    if (!current(j)) {
-      ++j;
-      continue;
-    }
-    int end = j + 1;
-    while (end < kMaxClones && current(end)) ++end;
-    ApplyTransitionRowsT(f, &s.P(CloneIndex(j), 0), kStateDim, 6 * (end - j));
-    j = end;
-  }
+  // Cross-covariance with the clones: X <- Phi X, deferred (FilterState): the step joins the
+  // pending product, Pi <- Phi Pi, by its blocks (names as in CoreTransitionProduct).
+  CoreTransitionProduct& pi = s.pending_transition;
+  const Eigen::Matrix3d FA = f.Fva * so3::Skew(f.a);
+  const Eigen::Matrix3d D = FA * pi.Tt;
+  const Eigen::Matrix3d E = FA * pi.Tg;
+  const double hdt = 0.5 * dt;
+  pi.Pt += dt * pi.Vt + hdt * D;
+  pi.Pa += dt * pi.Va + hdt * f.Fva;
+  pi.Pg += dt * pi.Vg + hdt * E;
+  pi.T += dt;
+  pi.Vt += D;
+  pi.Va += f.Fva;
+  pi.Vg += E;
+  pi.Tg = f.Ftt * pi.Tg + f.Ftg;
+  pi.Tt = f.Ftt * pi.Tt;
+  pi.identity = false;
   MarkDeferred(s);
 
   s.time = t1;

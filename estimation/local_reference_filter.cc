@@ -84,6 +84,7 @@ void LocalReferenceFilter::Initialize(Timestamp time, const Eigen::Vector3d& p,
   state_.phi.setIdentity();
   state_.cross_current.fill(false);
   state_.cross_pending = false;
+  state_.pending_transition = CoreTransitionProduct{};
   state_.P.topLeftCorner<15, 15>() = 0.5 * (covariance + covariance.transpose());
   initialized_ = true;
   have_last_imu_ = true;
@@ -342,6 +343,7 @@ void LocalReferenceFilter::Marginalize(int slot) {
 }
 
 void LocalReferenceFilter::AddClone(CloneId id) {
+  FlushTransition(state_);  // reads phi and the current cross blocks
   if (active_clones() >= options_.max_clones) {
     // Bounded: drop the least recently used clone (created or referenced as keyframe longest ago).
     int victim = -1;
