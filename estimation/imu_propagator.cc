@@ -71,8 +71,9 @@ Eigen::Matrix3d RightJacobianFromHalfAngle(const Eigen::Vector3d& phi, double s_
   const Eigen::Matrix3d W = so3::Skew(phi);
   if (theta2 < 1e-4) {
     // Series to the terms below double precision (no cancellation, no division).
-    const double a = 0.5 - theta2 / 24.0 * (1.0 - theta2 / 30.0 * (1.0 - theta2 / 56.0));
-    const double b = 1.0 / 6.0 - theta2 / 120.0 * (1.0 - theta2 / 42.0 * (1.0 - theta2 / 72.0));
+    const double t = theta2;
+    const double a = 0.5 - t * (1.0 / 24.0) * (1.0 - t * (1.0 / 30.0) * (1.0 - t * (1.0 / 56.0)));
+    const double b = 1.0 / 6.0 - t * (1.0 / 120.0) * (1.0 - t * (1.0 / 42.0) * (1.0 - t * (1.0 / 72.0)));
     return Eigen::Matrix3d::Identity() - a * W + b * W * W;
   }
   const double theta = std::sqrt(theta2);

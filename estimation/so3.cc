@@ -32,8 +32,10 @@ Eigen::Quaterniond ExpQuaternionSmall(const Eigen::Vector3d& w) {
   const double t2 = w.squaredNorm();
   if (t2 >= 1e-4) return ExpQuaternion(w);
   const double x2 = 0.25 * t2;  // (theta / 2)^2
-  const double real = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
-  const double imag = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+  // Horner form; the constants are reciprocals (a division per term would dominate).
+  const double real = 1.0 - x2 * 0.5 * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0))));
+  const double imag =
+      0.5 * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0)))));
   return Eigen::Quaterniond(real, imag * w.x(), imag * w.y(), imag * w.z());
 }
 
