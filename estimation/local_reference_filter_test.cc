@@ -207,9 +207,9 @@ TEST(LocalReferenceFilterTest, DelayedUpdatesAroundFrameSwitchesAreDeterministic
   EXPECT_EQ(c.frame_switches, 5u);
 }
 
-// Replay snapshots keep P packed (its current parts only): restoring must reproduce the saved
-// matrix bit for bit, from a deferred and from a complete covariance, into either kind of state.
-TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
+// The state after a short run with delayed relative poses and wheel updates: clones, their cross
+// blocks deferred or current.
+FilterState StateAfterDelayedRun() {
   ScenarioOptions s;
   s.duration = 2.0;
   s.update_delay = 0.25;
@@ -218,7 +218,13 @@ TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
   o.wheel_enabled = true;
   FilterScenario a(s, o);
   a.Run();
-  const FilterState deferred = a.filter().state();
+  return a.filter().state();
+}
+
+// Replay snapshots keep P packed (its current parts only): restoring must reproduce the saved
+// matrix bit for bit, from a deferred and from a complete covariance, into either kind of state.
+TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
+  const FilterState deferred = StateAfterDelayedRun();
   ASSERT_TRUE(deferred.cross_pending);
   // The stale parts of a deferred P are held at zero.
   constexpr int kCloneDims = kStateDim - kCoreDim;
@@ -248,15 +254,7 @@ TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
 // IMU steps reach phi and the current clone cross blocks as one block-structured product at the
 // next event: applying each step's product at once must give the same covariance.
 TEST(LocalReferenceFilterTest, PendingTransitionProductEqualsStepwiseApplication) {
-  ScenarioOptions s;
-  s.duration = 2.0;
-  s.update_delay = 0.25;
-  s.wheel_rate = 20.0;
-  FilterOptions o;
-  o.wheel_enabled = true;
-  FilterScenario a(s, o);
-  a.Run();
-  FilterState once = a.filter().state();
+  FilterState once = StateAfterDelayedRun();
   FlushTransition(once);
   ASSERT_TRUE(once.cross_pending);
   int current = 0, deferred = 0;
@@ -267,7 +265,8 @@ TEST(LocalReferenceFilterTest, PendingTransitionProductEqualsStepwiseApplication
   ASSERT_GT(current, 0);
   ASSERT_GT(deferred, 0);
   FilterState stepwise = once;
-  const ImuPropagator propagator(ImuNoise::FromCalibration(testing::TestCalibration()), o.gravity);
+  const ImuPropagator propagator(ImuNoise::FromCalibration(testing::TestCalibration()),
+                                   FilterOptions{}.gravity);
   for (int k = 1; k <= 40; ++k) {
     const double u = 0.05 * k;
     const Eigen::Vector3d accel(0.8 * std::sin(u), -0.5 * std::cos(2.0 * u), 9.81 + 0.3 * std::sin(3.0 * u));
