@@ -148,8 +148,7 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   top.block<3, 3>(kV, kV).diagonal().array() += qa * dt;
   top.block<3, 3>(kTheta, kTheta).diagonal().array() += qg * dt;
   s.P.topLeftCorner<9, 9>() = 0.5 * (top.leftCols<9>() + top.leftCols<9>().transpose());
-  s.P.block<9, 6>(0, 9) = top.rightCols<6>();
-  s.P.block<6, 9>(9, 0) = top.rightCols<6>().transpose();
+  s.P.block<9, 6>(0, 9) = top.rightCols<6>();  // the bias rows hold their transpose already (Y^T's)
   s.P.block<3, 3>(kBa, kBa).diagonal().array() += qba * dt;
   s.P.block<3, 3>(kBg, kBg).diagonal().array() += qbg * dt;
 
