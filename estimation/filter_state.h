@@ -39,6 +39,23 @@ struct CloneSlot {
   Timestamp last_used;
 };
 
+// The product of the IMU-step transitions since the last event, not yet applied to phi and the
+// current cross blocks (see FilterState). A product of step transitions keeps their block pattern
+//   [I  T I  Pt  Pa  Pg]
+//   [0  I    Vt  Va  Vg]
+//   [0  0    Tt  0   Tg]
+//   [0  0    0   I   0 ]
+//   [0  0    0   0   I ]
+// (rows and columns p, v, theta, ba, bg), so a step costs a few 3x3 products here instead of a pass
+// over phi and every current cross block; those get the product once, at the next event.
+struct CoreTransitionProduct {
+  bool identity = true;
+  double T = 0.0;
+  Eigen::Matrix3d Pt = Eigen::Matrix3d::Zero(), Pa = Eigen::Matrix3d::Zero(), Pg = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d Vt = Eigen::Matrix3d::Zero(), Va = Eigen::Matrix3d::Zero(), Vg = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d Tt = Eigen::Matrix3d::Identity(), Tg = Eigen::Matrix3d::Zero();
+};
+
 // Everything but the full covariance matrix (what a replay snapshot copies as is).
 struct FilterStateHead {
   Timestamp time;
@@ -58,6 +75,8 @@ struct FilterStateHead {
       Eigen::Matrix<double, kCoreDim, kCoreDim, Eigen::RowMajor>::Identity();
   std::array<bool, kMaxClones> cross_current{};
   bool cross_pending = false;
+  // Left factor of phi and of the current cross blocks' transitions not yet applied to them.
+  CoreTransitionProduct pending_transition;
 };
 
 struct FilterState : FilterStateHead {
@@ -67,7 +86,9 @@ struct FilterState : FilterStateHead {
   //  - the clone-core cross block of an active slot j is kept in the bottom-left block,
   //    B_j = P[CloneIndex(j) + 0..5, 0:15]. It is current if cross_current[j], else the true block
   //    is B_j phi^T: propagation and core-only updates (wheel, position) change the core-clone
-  //    cross-covariance by left-multiplication, which is accumulated in phi;
+  //    cross-covariance by left-multiplication, which is accumulated in phi; the IMU steps since
+  //    the last event are further held in pending_transition (Pi): the true cross block is
+  //    B_j phi^T Pi^T, or B_j Pi^T where it is current (FlushTransition applies Pi);
   //  - of the clone-clone block, the 6x6 blocks on and below the block diagonal are current;
   //  - the top-right block and the clone-clone blocks above the diagonal are stale and held at
   //    zero (MarkDeferred), so that a state restored from a packed snapshot (which keeps only the
@@ -81,6 +102,9 @@ struct FilterState : FilterStateHead {
 // Sets cross_pending, zeroing the stale parts of P if it was complete: every change that leaves P
 // in the deferred representation ends with it.
 void MarkDeferred(FilterState& s);
+// Applies pending_transition to phi and the current cross blocks (it becomes the identity). Every
+// reader of phi or of a current cross block calls it first.
+void FlushTransition(FilterState& s);
 // Makes every cross block current (applies phi, which becomes the identity).
 void MaterializeCross(FilterState& s);
 // Makes P complete and symmetric.

@@ -14,17 +14,6 @@ using CoreMatrix = Eigen::Matrix<double, kCoreDim, kCoreDim>;
 
 bool Active(const FilterState& s, int slot) { return s.clones[static_cast<size_t>(slot)].id != kNoClone; }
 
-// Exp of a rotation vector as a unit quaternion; for the small corrections of an update the
-// Taylor series (exact to double precision below 1e-2 rad) avoids the trigonometric functions.
-Eigen::Quaterniond ExpCorrection(const Eigen::Vector3d& w) {
-  const double t2 = w.squaredNorm();
-  if (t2 >= 1e-4) return so3::ExpQuaternion(w);
-  const double x2 = 0.25 * t2;  // (theta / 2)^2
-  const double real = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
-  const double imag = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
-  return Eigen::Quaterniond(real, imag * w.x(), imag * w.y(), imag * w.z()).normalized();
-}
-
 // C <- C - V V^T on the current part (on and below the block diagonal) of the clone-clone
 // covariance, V the clone rows of an update's W = P H^T L^-T. Column block by column block: each
 // is one contiguous run of rows from its diagonal block down. Free slots' columns are left alone
@@ -48,6 +37,7 @@ template <int M>
 UpdateOutcome CoreUpdate(FilterState& s, const Eigen::Matrix<double, M, kCoreDim>& H,
                          const Eigen::Matrix<double, M, 1>& r, const Eigen::Matrix<double, M, M>& R,
                          double gate) {
+  FlushTransition(s);
   const CoreMatrix Pc = s.P.topLeftCorner<kCoreDim, kCoreDim>();
   Eigen::Matrix<double, kCoreDim, M> W = Pc.lazyProduct(H.transpose());  // P H^T, then W_core
   Eigen::Matrix<double, M, M> S = H.lazyProduct(W) + R;
@@ -123,14 +113,14 @@ Eigen::Matrix<double, kStateDim, 6> CloneColumns(const FilterState& s, int slot)
 void InjectError(FilterState& s, const Eigen::Matrix<double, kStateDim, 1>& dx) {
   s.p += dx.segment<3>(kP);
   s.v += dx.segment<3>(kV);
-  s.q = (s.q * ExpCorrection(dx.segment<3>(kTheta))).normalized();
+  s.q = so3::RetractSmall(s.q, dx.segment<3>(kTheta));
   s.ba += dx.segment<3>(kBa);
   s.bg += dx.segment<3>(kBg);
   for (int i = 0; i < kMaxClones; ++i) {
     CloneSlot& c = s.clones[static_cast<size_t>(i)];
     if (c.id == kNoClone) continue;
     c.p_frame_imu += dx.segment<3>(CloneIndex(i));
-    c.q_frame_imu = (c.q_frame_imu * ExpCorrection(dx.segment<3>(CloneIndex(i) + 3))).normalized();
+    c.q_frame_imu = so3::RetractSmall(c.q_frame_imu, dx.segment<3>(CloneIndex(i) + 3));
   }
 }
 

@@ -69,7 +69,13 @@ CAIRN_WIDE_KERNEL void ApplyTransitionT(const Transition& f, double* m, int ld) 
 Eigen::Matrix3d RightJacobianFromHalfAngle(const Eigen::Vector3d& phi, double s_half, double c_half) {
   const double theta2 = phi.squaredNorm();
   const Eigen::Matrix3d W = so3::Skew(phi);
-  if (theta2 < 1e-10) return Eigen::Matrix3d::Identity() - 0.5 * W + W * W / 6.0;
+  if (theta2 < 1e-4) {
+    // Series to the terms below double precision (no cancellation, no division).
+    const double t = theta2;
+    const double a = 0.5 - t * (1.0 / 24.0) * (1.0 - t * (1.0 / 30.0) * (1.0 - t * (1.0 / 56.0)));
+    const double b = 1.0 / 6.0 - t * (1.0 / 120.0) * (1.0 - t * (1.0 / 42.0) * (1.0 - t * (1.0 / 72.0)));
+    return Eigen::Matrix3d::Identity() - a * W + b * W * W;
+  }
   const double theta = std::sqrt(theta2);
   const double one_minus_cos = 2.0 * s_half * s_half;
   const double sin_theta = 2.0 * s_half * c_half;
@@ -94,9 +100,9 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   const Eigen::Vector3d a1 = accel1 - s.ba;
   const Eigen::Matrix3d R0 = s.q.toRotationMatrix();
   const Eigen::Vector3d phi = w * dt;
-  const Eigen::Quaterniond dq = so3::ExpQuaternion(phi);
+  const Eigen::Quaterniond dq = so3::ExpQuaternionSmall(phi);
   const Eigen::Quaterniond q0 = s.q;
-  const Eigen::Quaterniond q1 = (q0 * dq).normalized();
+  const Eigen::Quaterniond q1 = so3::Normalized(q0 * dq);
   const Eigen::Matrix3d R1 = q1.toRotationMatrix();
   const Eigen::Vector3d acc_world = 0.5 * (R0 * a0 + R1 * a1) + gravity_;
   s.p += s.v * dt + 0.5 * acc_world * dt * dt;
@@ -110,7 +116,7 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   const double c_quarter = std::sqrt(0.5 * (1.0 + c_half));
   const Eigen::Quaterniond dq_mid(c_quarter, 0.5 / c_quarter * dq.x(), 0.5 / c_quarter * dq.y(),
                                   0.5 / c_quarter * dq.z());
-  const Eigen::Matrix3d R_mid = (q0 * dq_mid).normalized().toRotationMatrix();
+  const Eigen::Matrix3d R_mid = so3::Normalized(q0 * dq_mid).toRotationMatrix();
   Transition f;
   f.dt = dt;
   f.a = 0.5 * (a0 + a1);
@@ -142,20 +148,27 @@ void ImuPropagator::Propagate(FilterState& s, Timestamp t1, const Eigen::Vector3
   top.block<3, 3>(kV, kV).diagonal().array() += qa * dt;
   top.block<3, 3>(kTheta, kTheta).diagonal().array() += qg * dt;
   s.P.topLeftCorner<9, 9>() = 0.5 * (top.leftCols<9>() + top.leftCols<9>().transpose());
-  s.P.block<9, 6>(0, 9) = top.rightCols<6>();
-  s.P.block<6, 9>(9, 0) = top.rightCols<6>().transpose();
+  s.P.block<9, 6>(0, 9) = top.rightCols<6>();  // the bias rows hold their transpose already (Y^T's)
   s.P.block<3, 3>(kBa, kBa).diagonal().array() += qba * dt;
   s.P.block<3, 3>(kBg, kBg).diagonal().array() += qbg * dt;
 
-  // Cross-covariance with the clones: X <- Phi X, deferred in phi (phi <- Phi phi; phi is
-  // row-major, so its storage is phi^T) except for the clones whose cross block is kept current
-  // (stored transposed, B_j <- B_j Phi^T).
-  ApplyTransitionT<kCoreDim>(f, s.phi.data(), kCoreDim);
-  for (int j = 0; j < kMaxClones; ++j) {
-    const size_t u = static_cast<size_t>(j);
-    if (s.clones[u].id == kNoClone || !s.cross_current[u]) continue;
-    ApplyTransitionT<6>(f, &s.P(CloneIndex(j), 0), kStateDim);
-  }
+  // Cross-covariance with the clones: X <- Phi X, deferred (FilterState): the step joins the
+  // pending product, Pi <- Phi Pi, by its blocks (names as in CoreTransitionProduct).
+  CoreTransitionProduct& pi = s.pending_transition;
+  const Eigen::Matrix3d FA = f.Fva * so3::Skew(f.a);
+  const Eigen::Matrix3d D = FA * pi.Tt;
+  const Eigen::Matrix3d E = FA * pi.Tg;
+  const double hdt = 0.5 * dt;
+  pi.Pt += dt * pi.Vt + hdt * D;
+  pi.Pa += dt * pi.Va + hdt * f.Fva;
+  pi.Pg += dt * pi.Vg + hdt * E;
+  pi.T += dt;
+  pi.Vt += D;
+  pi.Va += f.Fva;
+  pi.Vg += E;
+  pi.Tg = f.Ftt * pi.Tg + f.Ftg;
+  pi.Tt = f.Ftt * pi.Tt;
+  pi.identity = false;
   MarkDeferred(s);
 
   s.time = t1;

@@ -84,6 +84,7 @@ void LocalReferenceFilter::Initialize(Timestamp time, const Eigen::Vector3d& p,
   state_.phi.setIdentity();
   state_.cross_current.fill(false);
   state_.cross_pending = false;
+  state_.pending_transition = CoreTransitionProduct{};
   state_.P.topLeftCorner<15, 15>() = 0.5 * (covariance + covariance.transpose());
   initialized_ = true;
   have_last_imu_ = true;
@@ -342,6 +343,7 @@ void LocalReferenceFilter::Marginalize(int slot) {
 }
 
 void LocalReferenceFilter::AddClone(CloneId id) {
+  FlushTransition(state_);  // reads phi and the current cross blocks
   if (active_clones() >= options_.max_clones) {
     // Bounded: drop the least recently used clone (created or referenced as keyframe longest ago).
     int victim = -1;
@@ -438,10 +440,10 @@ void LocalReferenceFilter::WriteHistory(uint64_t k) {
   PoseSample& h = history_[k % history_.size()];
   h.time = state_.time;
   h.frame_id = frame_id_;
-  h.T_frame_body = Eigen::Isometry3d::Identity();
-  h.T_frame_body.linear() = state_.q.toRotationMatrix();
-  h.T_frame_body.translation() = state_.p;
-  h.T_frame_body = h.T_frame_body * T_imu_body_;
+  // T_frame_imu T_imu_body by its parts (the full 4x4 product is most of this per-sample work).
+  const Eigen::Matrix3d R = state_.q.toRotationMatrix();
+  h.T_frame_body.linear() = R * T_imu_body_.linear();
+  h.T_frame_body.translation() = R * T_imu_body_.translation() + state_.p;
   h.covariance.topLeftCorner<3, 3>() = state_.P.block<3, 3>(kP, kP);
   h.covariance.topRightCorner<3, 3>() = state_.P.block<3, 3>(kP, kTheta);
   h.covariance.bottomLeftCorner<3, 3>() = state_.P.block<3, 3>(kTheta, kP);

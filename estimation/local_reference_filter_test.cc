@@ -8,6 +8,7 @@
 #include "estimation/filter_scenario.h"
 #include "estimation/filter_test_util.h"
 #include "estimation/filter_update.h"
+#include "estimation/imu_propagator.h"
 
 namespace cairn {
 namespace {
@@ -206,9 +207,9 @@ TEST(LocalReferenceFilterTest, DelayedUpdatesAroundFrameSwitchesAreDeterministic
   EXPECT_EQ(c.frame_switches, 5u);
 }
 
-// Replay snapshots keep P packed (its current parts only): restoring must reproduce the saved
-// matrix bit for bit, from a deferred and from a complete covariance, into either kind of state.
-TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
+// The state after a short run with delayed relative poses and wheel updates: clones, their cross
+// blocks deferred or current.
+FilterState StateAfterDelayedRun() {
   ScenarioOptions s;
   s.duration = 2.0;
   s.update_delay = 0.25;
@@ -217,7 +218,13 @@ TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
   o.wheel_enabled = true;
   FilterScenario a(s, o);
   a.Run();
-  const FilterState deferred = a.filter().state();
+  return a.filter().state();
+}
+
+// Replay snapshots keep P packed (its current parts only): restoring must reproduce the saved
+// matrix bit for bit, from a deferred and from a complete covariance, into either kind of state.
+TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
+  const FilterState deferred = StateAfterDelayedRun();
   ASSERT_TRUE(deferred.cross_pending);
   // The stale parts of a deferred P are held at zero.
   constexpr int kCloneDims = kStateDim - kCoreDim;
@@ -242,6 +249,37 @@ TEST(LocalReferenceFilterTest, PackedCovarianceRestoresTheMatrixExactly) {
           << "saved " << saved->cross_pending << " into " << target->cross_pending;
     }
   }
+}
+
+// IMU steps reach phi and the current clone cross blocks as one block-structured product at the
+// next event: applying each step's product at once must give the same covariance.
+TEST(LocalReferenceFilterTest, PendingTransitionProductEqualsStepwiseApplication) {
+  FilterState once = StateAfterDelayedRun();
+  FlushTransition(once);
+  ASSERT_TRUE(once.cross_pending);
+  int current = 0, deferred = 0;
+  for (int j = 0; j < kMaxClones; ++j) {
+    if (once.clones[static_cast<size_t>(j)].id == kNoClone) continue;
+    (once.cross_current[static_cast<size_t>(j)] ? current : deferred) += 1;
+  }
+  ASSERT_GT(current, 0);
+  ASSERT_GT(deferred, 0);
+  FilterState stepwise = once;
+  const ImuPropagator propagator(ImuNoise::FromCalibration(testing::TestCalibration()),
+                                   FilterOptions{}.gravity);
+  for (int k = 1; k <= 40; ++k) {
+    const double u = 0.05 * k;
+    const Eigen::Vector3d accel(0.8 * std::sin(u), -0.5 * std::cos(2.0 * u), 9.81 + 0.3 * std::sin(3.0 * u));
+    const Eigen::Vector3d gyro(0.4 * std::cos(u), 0.2 * std::sin(2.0 * u), -0.6 * std::sin(u));
+    const Timestamp t = once.time + Duration::Milliseconds(5);
+    propagator.Propagate(once, t, accel, gyro);
+    propagator.Propagate(stepwise, t, accel, gyro);
+    FlushTransition(stepwise);
+  }
+  ASSERT_FALSE(once.pending_transition.identity);
+  MaterializeCovariance(once);
+  MaterializeCovariance(stepwise);
+  EXPECT_LT((once.P - stepwise.P).cwiseAbs().maxCoeff(), 1e-12 * once.P.cwiseAbs().maxCoeff());
 }
 
 TEST(LocalReferenceFilterTest, FrameSwitchKeepsPoseAndResetsPositionAndYaw) {

@@ -28,6 +28,21 @@ Eigen::Quaterniond ExpQuaternion(const Eigen::Vector3d& w) {
   return q.normalized();
 }
 
+Eigen::Quaterniond ExpQuaternionSmall(const Eigen::Vector3d& w) {
+  const double t2 = w.squaredNorm();
+  if (t2 >= 1e-4) return ExpQuaternion(w);
+  const double x2 = 0.25 * t2;  // (theta / 2)^2
+  // Horner form; the constants are reciprocals (a division per term would dominate).
+  const double real = 1.0 - x2 * 0.5 * (1.0 - x2 * (1.0 / 12.0) * (1.0 - x2 * (1.0 / 30.0) * (1.0 - x2 * (1.0 / 56.0))));
+  const double imag =
+      0.5 * (1.0 - x2 * (1.0 / 6.0) * (1.0 - x2 * (1.0 / 20.0) * (1.0 - x2 * (1.0 / 42.0) * (1.0 - x2 * (1.0 / 72.0)))));
+  return Eigen::Quaterniond(real, imag * w.x(), imag * w.y(), imag * w.z());
+}
+
+Eigen::Quaterniond RetractSmall(const Eigen::Quaterniond& q, const Eigen::Vector3d& w) {
+  return Normalized(q * ExpQuaternionSmall(w));
+}
+
 Eigen::Matrix3d Exp(const Eigen::Vector3d& w) { return ExpQuaternion(w).toRotationMatrix(); }
 
 Eigen::Vector3d Log(const Eigen::Quaterniond& q_in) {
