@@ -5,7 +5,9 @@
 // 100 Hz with the non-holonomic constraint: --wheel-rate 100 --nonholonomic).
 // The measured loop runs as the daemon's filter thread does: SCHED_FIFO at the estimation
 // executor's priority with the process memory locked (--no-realtime to skip); where the system
-// refuses, it runs normally and the JSON says why.
+// refuses, it runs normally and the JSON says why. "machine_stalls" spins as long again in the
+// same thread settings and reports the longest gap between two clock reads: the part of any
+// maximum that the machine, not the filter, is responsible for.
 
 #include <algorithm>
 #include <chrono>
@@ -39,6 +41,38 @@ void PrintStats(const Timings& t, bool last) {
   std::printf("    \"%s\": {\"count\": %zu, \"mean_us\": %.3f, \"median_us\": %.3f, \"p99_us\": %.3f, "
               "\"max_us\": %.3f}%s\n",
               t.name, v.size(), mean, pct(0.5), pct(0.99), v.empty() ? 0.0 : v.back(), last ? "" : ",");
+}
+
+struct StallStats {
+  double spin_s = 0.0;
+  double max_gap_us = 0.0;
+  long over_50us = 0;
+  long over_200us = 0;
+};
+
+// Spins for `seconds` of busy time (pausing as the measured loop does) and records the gaps between
+// consecutive clock reads.
+StallStats MeasureStalls(double seconds) {
+  using Clock = std::chrono::steady_clock;
+  StallStats st;
+  const auto budget = std::chrono::duration<double>(seconds);
+  std::chrono::duration<double> busy{0.0};
+  while (busy < budget) {
+    const Clock::time_point start = Clock::now();
+    Clock::time_point prev = start;
+    while (prev - start < std::chrono::milliseconds(20) && busy + (prev - start) < budget) {
+      const Clock::time_point now = Clock::now();
+      const double gap_us = std::chrono::duration<double, std::micro>(now - prev).count();
+      st.max_gap_us = std::max(st.max_gap_us, gap_us);
+      st.over_50us += gap_us > 50.0 ? 1 : 0;
+      st.over_200us += gap_us > 200.0 ? 1 : 0;
+      prev = now;
+    }
+    busy += prev - start;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  st.spin_s = busy.count();
+  return st;
 }
 
 }  // namespace
@@ -108,6 +142,18 @@ int RunBenchFilter(const CommandArgs& args) {
     }
   });
   thread.Join();
+  // The machine's own stalls, for reading the maxima: the same thread settings spin for as long as
+  // the filter was measured, reading the clock back to back. A gap between two reads is time in
+  // which no code of this thread ran (preemption by the kernel or, on a VM, by the hypervisor), and
+  // a filter step timed across it would have shown it too.
+  double measured_s = 0.0;
+  for (const auto& x : t) {
+    for (double us : x.us) measured_s += us * 1e-6;
+  }
+  StallStats stalls;
+  Executor spinner("bench-stalls", eo);
+  spinner.Start([&](std::stop_token) { stalls = MeasureStalls(measured_s); });
+  spinner.Join();
   std::string rt_note = thread.report().affinity_note;
   if (realtime && !locked) rt_note += (rt_note.empty() ? "" : "; ") + lock_note;
   const FilterCounters& c = scenario.filter().counters();
@@ -123,7 +169,9 @@ int RunBenchFilter(const CommandArgs& args) {
               static_cast<unsigned long>(c.replayed_imu_samples));
   std::printf("  \"timings\": {\n");
   for (size_t i = 0; i < t.size(); ++i) PrintStats(t[i], i + 1 == t.size());
-  std::printf("  }\n}\n");
+  std::printf("  },\n  \"machine_stalls\": {\"spin_s\": %.3f, \"max_gap_us\": %.3f, \"gaps_over_50us\": %ld, "
+              "\"gaps_over_200us\": %ld}\n}\n",
+              stalls.spin_s, stalls.max_gap_us, stalls.over_50us, stalls.over_200us);
   return 0;
 }
 

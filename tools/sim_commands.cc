@@ -101,7 +101,8 @@ int RunSim(const CommandArgs& args) {
   sim::MissionOptions mission;
   mission.robots = {"rover", "hexacopter"};
   int64_t seed = -1;
-  for (size_t i = 0; i < args.args.size(); ++i) {
+  // Every option takes a value.
+  for (size_t i = 0; i < args.args.size(); i += 2) {
     const std::string a = args.args[i];
     const bool has_value = i + 1 < args.args.size();
     const std::string value = has_value ? args.args[i + 1] : "";
@@ -127,7 +128,6 @@ int RunSim(const CommandArgs& args) {
       std::fprintf(stderr, "cairn sim: bad or incomplete argument '%s'\n%s", a.c_str(), kSimUsage);
       return 2;
     }
-    ++i;
   }
   if (out.empty()) {
     std::fprintf(stderr, "cairn sim: --out DIR is required\n%s", kSimUsage);
