@@ -7,6 +7,9 @@ namespace cairn {
 namespace {
 uint64_t PackOctoKey(const octomap::OcTreeKey& k) { return VoxelKey::Pack(k[0], k[1], k[2]); }
 
+// The key of the cell at the origin of an OcTree of depth 16 (OcTreeBaseImpl::tree_max_val).
+constexpr int kTreeMaxVal = 1 << 15;
+
 // OcTree::updateNode(key, occupied, lazy) for every key, with the same result (including its
 // early abort on saturated nodes), but without its two descents from the root per key: the keys
 // come in spatially coherent order (along rays, along image rows), so the path of the previous
@@ -108,20 +111,35 @@ OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, oct
   overflow_.Clear();
   occupied_.clear();
   free_.clear();
-  octomap::OcTreeKey key, last(0, 0, 0);
-  bool have_last = false;
+  // Most points fall into a voxel an earlier point of the image already marked: neighbouring
+  // pixels of a row share it, and the rows above left it. The image's marks are remembered in a
+  // small direct-mapped set (a miss only costs the exact test through the stamps), because a
+  // stamp lookup in the large cube misses the CPU caches.
+  std::fill(recent_.begin(), recent_.end(), kNoKey);
+  const double factor = 1.0 / tree->getResolution();
   for (const Eigen::Vector3f& p : pts.p_local) {
-    if (!tree->coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
-    // Neighbouring pixels of a row mostly fall into the same 0.1 m voxel.
-    if (have_last && key == last) continue;
-    last = key;
-    have_last = true;
+    // OcTreeBaseImpl::coordToKeyChecked: floor(resolution_factor * coordinate) + 2^15, in range.
+    int k[3];
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) {
+      const double s = factor * static_cast<double>(p[a]);
+      inside = inside && s >= -kTreeMaxVal && s < kTreeMaxVal;
+      const int t = inside ? static_cast<int>(s) : 0;
+      k[a] = t - (static_cast<double>(t) > s) + kTreeMaxVal;
+    }
+    if (!inside) continue;
+    const uint64_t packed = static_cast<uint64_t>(k[0]) | static_cast<uint64_t>(k[1]) << 16 | static_cast<uint64_t>(k[2]) << 32;
+    uint64_t& seen = recent_[static_cast<size_t>((packed * 0x9E3779B97F4A7C15ull) >> (64 - kRecentBits))];
+    if (seen == packed) continue;
+    seen = packed;
+    const octomap::OcTreeKey key(static_cast<uint16_t>(k[0]), static_cast<uint16_t>(k[1]), static_cast<uint16_t>(k[2]));
     uint32_t& s = Stamp(key);
     if (s != kOccupied) {
       s = kOccupied;
       occupied_.push_back(key);
     }
   }
+  octomap::OcTreeKey key;
   const auto cast = [&](const octomap::point3d& end) {
     ++stats.rays;
     if (!tree->computeRayKeys(origin, end, ray_)) return;

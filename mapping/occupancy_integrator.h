@@ -48,6 +48,10 @@ class OccupancyIntegrator {
   uint32_t generation_ = 0;
   std::vector<octomap::OcTreeKey> occupied_, free_;
   VoxelHashMap<uint8_t> far_seen_;
+  // Keys (x | y << 16 | z << 32) marked occupied recently in this image, direct mapped.
+  static constexpr int kRecentBits = 12;
+  static constexpr uint64_t kNoKey = ~uint64_t{0};
+  std::vector<uint64_t> recent_ = std::vector<uint64_t>(size_t{1} << kRecentBits, kNoKey);
   octomap::KeyRay ray_;
 };
 

@@ -67,10 +67,23 @@ class VoxelCloud {
   CloudPoint Centroid(uint64_t key, const Accum& a) const;
   void AddKeyed(uint64_t key, const CloudPoint& c, int32_t weight);
 
+  // The table's value for `key` through a small direct-mapped cache of recent keys: the runs of an
+  // image alternate among a few voxels (stereo noise moves neighbouring pixels between depth
+  // layers), so most lookups would otherwise miss the CPU cache in a table of megabytes.
+  Accum& CachedSlot(uint64_t key);
+
+  struct Recent {
+    uint64_t key = VoxelKey::kEmpty;
+    Accum* accum = nullptr;
+  };
+  static constexpr int kRecentBits = 8;
+
   double res_;
   float inv_res_;
   VoxelHashMap<Accum> voxels_;
   std::vector<uint64_t> keys_;  // scratch of AddAll
+  std::vector<Recent> recent_;  // 1 << kRecentBits entries, within AddBatch only
+  size_t recent_capacity_ = 0;
 };
 
 }  // namespace cairn

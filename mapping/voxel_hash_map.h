@@ -53,6 +53,8 @@ class VoxelHashMap {
   explicit VoxelHashMap(size_t expected = 1024) { Rehash(std::bit_ceil(std::max<size_t>(16, 2 * expected))); }
 
   size_t size() const { return size_; }
+  // Slots; changes exactly when the table rehashes (which moves every value).
+  size_t capacity() const { return slots_.size(); }
   bool empty() const { return size_ == 0; }
 
   // Keeps the capacity (no allocation when refilled to a similar size).
