@@ -9,7 +9,7 @@ VoxelCloud::VoxelCloud(double resolution, size_t expected_voxels)
     : res_(resolution),
       inv_res_(static_cast<float>(1.0 / resolution)),
       voxels_(expected_voxels),
-      recent_(size_t{1} << kRecentBits) {}
+      pending_(size_t{1} << kPendingBits) {}
 
 size_t VoxelCloud::size() const {
   size_t n = 0;
@@ -58,60 +58,35 @@ void VoxelCloud::AddAll(const std::vector<CloudPoint>& points, int32_t weight) {
 
 size_t VoxelCloud::AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
                             const std::vector<uint8_t>& obstacle) {
+  for (Pending& e : pending_) e.key = VoxelKey::kEmpty;
   size_t dropped = 0;
-  uint64_t run_key = VoxelKey::kEmpty;
-  Accum run;
-  Eigen::Vector3f corner = Eigen::Vector3f::Zero();
-  // The run's cell in scaled coordinates: a point continues the run while lo <= p * inv_res_ < lo + 1
-  // on every axis, which is floor(p * inv_res_) == key (the same float product as VoxelKey::Of)
-  // without the floors and the packing. Empty bounds until the first run starts.
-  Eigen::Array3f lo = Eigen::Array3f::Constant(1.0f), hi = Eigen::Array3f::Zero();
-  // Cached pointers live for one batch only (copies and Clear() would leave them stale).
-  std::fill(recent_.begin(), recent_.end(), Recent{});
-  recent_capacity_ = voxels_.capacity();
-  const auto flush = [&] {
-    if (run_key != VoxelKey::kEmpty) CachedSlot(run_key).Merge(run);
-  };
   for (size_t i = 0; i < p.size(); ++i) {
-    const Eigen::Array3f s = p[i].array() * inv_res_;
-    if (!((s >= lo).all() && (s < hi).all())) {
-      uint64_t key;
-      if (!VoxelKey::Of(p[i], inv_res_, &key)) {
-        ++dropped;
-        continue;
-      }
-      flush();
-      run_key = key;
-      run = Accum{};
-      lo = VoxelKey::Unpack(key).cast<float>().array();
-      hi = lo + 1.0f;
-      corner = lo.matrix() * static_cast<float>(res_);
+    uint64_t key;
+    if (!VoxelKey::Of(p[i], inv_res_, &key)) {
+      ++dropped;
+      continue;
     }
-    const Eigen::Vector3f d = p[i] - corner;
-    run.sx += d.x();
-    run.sy += d.y();
-    run.sz += d.z();
-    ++run.n;
-    run.sr += gray[i];
-    run.sg += gray[i];
-    run.sb += gray[i];
-    run.obstacles += obstacle[i] != 0;
+    Pending& e = pending_[static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - kPendingBits))];
+    if (e.key != key) {
+      if (e.key != VoxelKey::kEmpty) voxels_[e.key].Merge(e.sum);
+      e.key = key;
+      e.sum = Accum{};
+      e.corner = VoxelKey::Unpack(key).cast<float>() * static_cast<float>(res_);
+    }
+    const Eigen::Vector3f d = p[i] - e.corner;
+    e.sum.sx += d.x();
+    e.sum.sy += d.y();
+    e.sum.sz += d.z();
+    ++e.sum.n;
+    e.sum.sr += gray[i];
+    e.sum.sg += gray[i];
+    e.sum.sb += gray[i];
+    e.sum.obstacles += obstacle[i] != 0;
   }
-  flush();
+  for (const Pending& e : pending_) {
+    if (e.key != VoxelKey::kEmpty) voxels_[e.key].Merge(e.sum);
+  }
   return dropped;
-}
-
-VoxelCloud::Accum& VoxelCloud::CachedSlot(uint64_t key) {
-  Recent& r = recent_[static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - kRecentBits))];
-  if (r.key == key && recent_capacity_ == voxels_.capacity()) return *r.accum;
-  Accum& a = voxels_[key];
-  if (recent_capacity_ != voxels_.capacity()) {
-    // The table rehashed: every cached pointer is stale.
-    std::fill(recent_.begin(), recent_.end(), Recent{});
-    recent_capacity_ = voxels_.capacity();
-  }
-  r = {key, &a};
-  return a;
 }
 
 CloudPoint VoxelCloud::Centroid(uint64_t key, const Accum& a) const {

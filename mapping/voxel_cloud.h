@@ -32,8 +32,8 @@ class VoxelCloud {
   // Returns false for points outside the key range.
   bool Add(const Eigen::Vector3f& p, uint8_t r, uint8_t g, uint8_t b, bool obstacle, int32_t weight = 1);
   bool Add(const CloudPoint& c, int32_t weight = 1) { return Add(c.p, c.r, c.g, c.b, c.obstacle != 0, weight); }
-  // Gray points of one image: runs of neighbouring pixels in the same voxel are summed before one
-  // hash lookup per run (at 0.05 m a voxel spans many pixels of a row). Returns points dropped.
+  // Gray points of one image, summed per voxel in a small cache before one hash lookup per voxel
+  // and image (mostly). Returns points dropped.
   size_t AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
                   const std::vector<uint8_t>& obstacle);
 
@@ -67,23 +67,22 @@ class VoxelCloud {
   CloudPoint Centroid(uint64_t key, const Accum& a) const;
   void AddKeyed(uint64_t key, const CloudPoint& c, int32_t weight);
 
-  // The table's value for `key` through a small direct-mapped cache of recent keys: the runs of an
-  // image alternate among a few voxels (stereo noise moves neighbouring pixels between depth
-  // layers), so most lookups would otherwise miss the CPU cache in a table of megabytes.
-  Accum& CachedSlot(uint64_t key);
-
-  struct Recent {
+  // Sums of one image's points per voxel before they reach the table, direct mapped by key: stereo
+  // noise moves neighbouring pixels between depth layers, so runs of one voxel along a row are
+  // short, but the few voxels a stretch of rows hits stay here, and the table (megabytes, out of
+  // the CPU caches) sees each about once per image.
+  struct Pending {
     uint64_t key = VoxelKey::kEmpty;
-    Accum* accum = nullptr;
+    Eigen::Vector3f corner = Eigen::Vector3f::Zero();
+    Accum sum;
   };
-  static constexpr int kRecentBits = 8;
+  static constexpr int kPendingBits = 12;
 
   double res_;
   float inv_res_;
   VoxelHashMap<Accum> voxels_;
   std::vector<uint64_t> keys_;  // scratch of AddAll
-  std::vector<Recent> recent_;  // 1 << kRecentBits entries, within AddBatch only
-  size_t recent_capacity_ = 0;
+  std::vector<Pending> pending_;  // 1 << kPendingBits entries, used within AddBatch
 };
 
 }  // namespace cairn
