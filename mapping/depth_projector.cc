@@ -23,7 +23,8 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
       (!image.intensity.empty() && image.intensity.size() != image.depth.size())) {
     return InvalidArgumentError("depth image buffers do not match its size");
   }
-  out->Clear();
+  // Not Clear(): the point buffers are resized below, keeping what they hold.
+  out->far_local.clear();
   out->time = image.time;
   out->T_local_cam = T_local_body * camera_.T_body_cam;
   const Eigen::Matrix3f R = out->T_local_cam.linear().cast<float>();
@@ -35,6 +36,23 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
   const float c = static_cast<float>(model_.DepthError(1.0));
   const int stride = static_cast<int>(options_.far_ray_stride_px);
   const bool has_intensity = !image.intensity.empty();
+  // Sized for every pixel and written through raw pointers, then cut to the points kept: with
+  // push_back the uint8_t stores may alias the vectors' own pointers, which the compiler then
+  // reloads and stores for every point. Resizing keeps the previous image's elements, so only the
+  // few pixels beyond its point count are initialised.
+  const size_t pixels = image.depth.size();
+  out->p_cam.resize(pixels);
+  out->p_local.resize(pixels);
+  out->depth_error.resize(pixels);
+  out->pixel.resize(pixels);
+  out->intensity.resize(pixels);
+  Eigen::Vector3f* p_cam = out->p_cam.data();
+  Eigen::Vector3f* p_local = out->p_local.data();
+  float* depth_error = out->depth_error.data();
+  uint32_t* pixel = out->pixel.data();
+  uint8_t* intensity = out->intensity.data();
+  const uint8_t* gray = image.intensity.data();
+  size_t n = 0;
   for (int v = 0; v < image.height; ++v) {
     const float y = (static_cast<float>(v) - cy) * fy_inv;
     const float* row = image.depth.data() + static_cast<size_t>(v) * static_cast<size_t>(image.width);
@@ -46,11 +64,12 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
       if (z <= zmax) {
         const Eigen::Vector3f p(x * z, y * z, z);
         const uint32_t pix = static_cast<uint32_t>(v * image.width + u);
-        out->p_cam.push_back(p);
-        out->p_local.push_back(R * p + t);
-        out->depth_error.push_back(c * z * z);
-        out->pixel.push_back(pix);
-        out->intensity.push_back(has_intensity ? image.intensity[pix] : uint8_t{0});
+        p_cam[n] = p;
+        p_local[n] = R * p + t;
+        depth_error[n] = c * z * z;
+        pixel[n] = pix;
+        intensity[n] = has_intensity ? gray[pix] : uint8_t{0};
+        ++n;
       } else if (far_row && u % stride == 0) {
         // The ray is free up to the range limit, measured along it like OctoMap's maxrange.
         const Eigen::Vector3f dir = Eigen::Vector3f(x, y, 1.0f).normalized();
@@ -58,6 +77,11 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
       }
     }
   }
+  out->p_cam.resize(n);
+  out->p_local.resize(n);
+  out->depth_error.resize(n);
+  out->pixel.resize(n);
+  out->intensity.resize(n);
   out->obstacle.assign(out->p_cam.size(), 0);
   return Status::Ok();
 }

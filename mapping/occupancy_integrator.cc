@@ -7,6 +7,9 @@ namespace cairn {
 namespace {
 uint64_t PackOctoKey(const octomap::OcTreeKey& k) { return VoxelKey::Pack(k[0], k[1], k[2]); }
 
+// The key of the cell at the origin of an OcTree of depth 16 (OcTreeBaseImpl::tree_max_val).
+constexpr int kTreeMaxVal = 1 << 15;
+
 // OcTree::updateNode(key, occupied, lazy) for every key, with the same result (including its
 // early abort on saturated nodes), but without its two descents from the root per key: the keys
 // come in spatially coherent order (along rays, along image rows), so the path of the previous
@@ -91,8 +94,7 @@ uint32_t& OccupancyIntegrator::Stamp(const octomap::OcTreeKey& k) {
   return overflow_[PackOctoKey(k)];
 }
 
-OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, octomap::OcTree* tree) {
-  OccupancyUpdateStats stats;
+bool OccupancyIntegrator::Begin(const CameraPoints& pts, octomap::OcTree* tree) {
   // Stamps: generation g marks "free this image", g + 1 "occupied this image"; older values are
   // stale. On wrap-around everything is reset once.
   if (generation_ >= 0xFFFFFFF0u) {
@@ -101,27 +103,77 @@ OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, oct
     generation_ = 0;
   }
   generation_ += 2;
-  const uint32_t kFree = generation_, kOccupied = generation_ + 1;
   const Eigen::Vector3d o = pts.T_local_cam.translation();
-  const octomap::point3d origin(static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z()));
-  if (!tree->coordToKeyChecked(origin, centre_)) return stats;
+  origin_ = octomap::point3d(static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z()));
+  if (!tree->coordToKeyChecked(origin_, centre_)) return false;
   overflow_.Clear();
   occupied_.clear();
   free_.clear();
-  octomap::OcTreeKey key, last(0, 0, 0);
-  bool have_last = false;
-  for (const Eigen::Vector3f& p : pts.p_local) {
-    if (!tree->coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) continue;
-    // Neighbouring pixels of a row mostly fall into the same 0.1 m voxel.
-    if (have_last && key == last) continue;
-    last = key;
-    have_last = true;
-    uint32_t& s = Stamp(key);
-    if (s != kOccupied) {
-      s = kOccupied;
-      occupied_.push_back(key);
-    }
+  factor_ = 1.0 / tree->getResolution();
+  // Most points fall into a voxel an earlier point of the image already marked: neighbouring
+  // pixels of a row share it, and the rows above left it. The image's marks are remembered in a
+  // small direct-mapped set (a miss only costs the exact test through the stamps), because a
+  // stamp lookup in the large cube misses the CPU caches.
+  std::fill(recent_.begin(), recent_.end(), kNoKey);
+  return true;
+}
+
+void OccupancyIntegrator::MarkOccupied(int kx, int ky, int kz) {
+  const uint64_t packed = static_cast<uint64_t>(kx) | static_cast<uint64_t>(ky) << 16 | static_cast<uint64_t>(kz) << 32;
+  uint64_t& seen = recent_[static_cast<size_t>((packed * 0x9E3779B97F4A7C15ull) >> (64 - kRecentBits))];
+  if (seen == packed) return;
+  seen = packed;
+  const octomap::OcTreeKey key(static_cast<uint16_t>(kx), static_cast<uint16_t>(ky), static_cast<uint16_t>(kz));
+  uint32_t& s = Stamp(key);
+  if (s != generation_ + 1) {
+    s = generation_ + 1;
+    occupied_.push_back(key);
   }
+}
+
+void OccupancyIntegrator::MarkPoint(const Eigen::Vector3f& p) {
+  // OcTreeBaseImpl::coordToKeyChecked: floor(resolution_factor * coordinate) + 2^15, in range.
+  int k[3];
+  bool inside = true;
+  for (int a = 0; a < 3; ++a) {
+    const double s = factor_ * static_cast<double>(p[a]);
+    inside = inside && s >= -kTreeMaxVal && s < kTreeMaxVal;
+    const int t = inside ? static_cast<int>(s) : 0;
+    k[a] = t - (static_cast<double>(t) > s) + kTreeMaxVal;
+  }
+  if (inside) MarkOccupied(k[0], k[1], k[2]);
+}
+
+OccupancyUpdateStats OccupancyIntegrator::Integrate(const CameraPoints& pts, octomap::OcTree* tree) {
+  if (!Begin(pts, tree)) return {};
+  for (const Eigen::Vector3f& p : pts.p_local) MarkPoint(p);
+  return CastAndUpdate(pts, tree);
+}
+
+// A point strictly inside cloud cell k (k < s < k + 1 for s = fl32(p * c) on every axis) has
+// k < p * c < k + 1 exactly, since rounding is monotonic and k, k + 1 are floats (|k| < 2^24).
+// With c = 2 f exactly, p * f lies in (k / 2, (k + 1) / 2), an interval holding no integer in its
+// inside, and its double rounding cannot reach the integer (k + 1) / 2 (that would take a float
+// rounding of p * c to k + 1): the tree's key is floor(k / 2), the same for all such points.
+OccupancyUpdateStats OccupancyIntegrator::IntegrateCells(const CameraPoints& pts, const VoxelCloud::Cells& cells,
+                                                         float cloud_inv_resolution, octomap::OcTree* tree) {
+  if (static_cast<double>(cloud_inv_resolution) != 2.0 * (1.0 / tree->getResolution())) return Integrate(pts, tree);
+  if (!Begin(pts, tree)) return {};
+  for (const uint64_t cell : cells.interior) {
+    const Eigen::Vector3i c = VoxelKey::Unpack(cell);
+    const int kx = (c.x() >> 1) + kTreeMaxVal, ky = (c.y() >> 1) + kTreeMaxVal, kz = (c.z() >> 1) + kTreeMaxVal;
+    constexpr int kKeys = 2 * kTreeMaxVal;
+    if (kx >= 0 && ky >= 0 && kz >= 0 && kx < kKeys && ky < kKeys && kz < kKeys) MarkOccupied(kx, ky, kz);
+  }
+  for (const uint32_t i : cells.on_face) MarkPoint(pts.p_local[i]);
+  return CastAndUpdate(pts, tree);
+}
+
+OccupancyUpdateStats OccupancyIntegrator::CastAndUpdate(const CameraPoints& pts, octomap::OcTree* tree) {
+  OccupancyUpdateStats stats;
+  const uint32_t kFree = generation_;
+  const octomap::point3d origin = origin_;
+  octomap::OcTreeKey key;
   const auto cast = [&](const octomap::point3d& end) {
     ++stats.rays;
     if (!tree->computeRayKeys(origin, end, ray_)) return;

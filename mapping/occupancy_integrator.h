@@ -15,6 +15,7 @@
 
 #include "mapping/depth_image.h"
 #include "mapping/mapping_options.h"
+#include "mapping/voxel_cloud.h"
 #include "mapping/voxel_hash_map.h"
 
 namespace cairn {
@@ -36,10 +37,25 @@ class OccupancyIntegrator {
 
   // Adds the points (local frame, already filtered by range) and the free-only ray ends.
   OccupancyUpdateStats Integrate(const CameraPoints& points, octomap::OcTree* tree);
+  // The same update from the cells VoxelCloud::AddBatch found for these points (cloud inverse
+  // resolution `cloud_inv_resolution`), without a pass over the points: when the cloud's
+  // resolution is exactly half the tree's (0.05 m and 0.1 m), every tree voxel with a point strictly
+  // inside a cloud cell is that cell's parent. Other resolutions fall back to Integrate.
+  OccupancyUpdateStats IntegrateCells(const CameraPoints& points, const VoxelCloud::Cells& cells,
+                                      float cloud_inv_resolution, octomap::OcTree* tree);
 
  private:
+  // Starts an image; false when the camera is outside the tree's key range.
+  bool Begin(const CameraPoints& points, octomap::OcTree* tree);
+  // Marks a tree key (OcTreeKey values) / the voxel of a point occupied, once per image.
+  void MarkOccupied(int kx, int ky, int kz);
+  void MarkPoint(const Eigen::Vector3f& p);
+  // Rays to the occupied voxels and the far ends, then the tree's leaves.
+  OccupancyUpdateStats CastAndUpdate(const CameraPoints& points, octomap::OcTree* tree);
   uint32_t& Stamp(const octomap::OcTreeKey& k);
 
+  double factor_ = 0.0;  // the tree's resolution_factor
+  octomap::point3d origin_;
   int side_ = 0;
   octomap::OcTreeKey centre_;
   std::vector<uint32_t> stamps_;
@@ -47,6 +63,10 @@ class OccupancyIntegrator {
   uint32_t generation_ = 0;
   std::vector<octomap::OcTreeKey> occupied_, free_;
   VoxelHashMap<uint8_t> far_seen_;
+  // Keys (x | y << 16 | z << 32) marked occupied recently in this image, direct mapped.
+  static constexpr int kRecentBits = 12;
+  static constexpr uint64_t kNoKey = ~uint64_t{0};
+  std::vector<uint64_t> recent_ = std::vector<uint64_t>(size_t{1} << kRecentBits, kNoKey);
   octomap::KeyRay ray_;
 };
 

@@ -91,5 +91,56 @@ TEST(OccupancyIntegratorTest, MatchesOctomapInsertPointCloudDiscretized) {
   EXPECT_GT(leaves, 1000u);
 }
 
+// The cloud's cells give the same tree as the points themselves, including points on the faces of
+// cloud cells (p * 20 an integer in float, where float rounding may have moved them) and points
+// whose float product rounds onto a face from below.
+TEST(OccupancyIntegratorTest, CellsOfTheCloudGiveTheSameTreeAsThePoints) {
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<Eigen::Vector3f> p;
+  for (int i = 0; i < 30000; ++i) {
+    const float x = 1.0f + 2.0f * (u(rng) + 1.0f), y = 2.0f * u(rng);
+    p.emplace_back(x, y, 0.1f * std::sin(3.0f * x) + 0.02f * u(rng));
+  }
+  // On faces: multiples of 0.05 and their float neighbours below (some of which round up onto
+  // the face when scaled).
+  for (int k = -40; k < 40; ++k) {
+    const float f = static_cast<float>(k) * 0.05f;
+    for (const float c : {f, std::nextafter(f, -1e9f), std::nextafter(std::nextafter(f, -1e9f), -1e9f)}) {
+      p.emplace_back(c, 0.5f, 0.3f);
+      p.emplace_back(2.0f, c, 0.3f);
+      p.emplace_back(2.0f, 0.5f, c);
+    }
+  }
+  const CameraPoints pts = PointsAt({0.33, -0.21, 1.27}, p);
+  VoxelCloud cloud(0.05);
+  VoxelCloud::Cells cells;
+  cloud.AddBatch(pts.p_local, pts.intensity, pts.obstacle, &cells);
+  EXPECT_FALSE(cells.on_face.empty());
+  auto a = MakeOccupancyTree(SubmapOptions{}), b = MakeOccupancyTree(SubmapOptions{});
+  OccupancyIntegrator ia(0.1, 6.0), ib(0.1, 6.0);
+  const OccupancyUpdateStats sa = ia.IntegrateCells(pts, cells, cloud.inv_resolution(), a.get());
+  const OccupancyUpdateStats sb = ib.Integrate(pts, b.get());
+  EXPECT_EQ(sa.occupied, sb.occupied);
+  EXPECT_EQ(sa.free, sb.free);
+  EXPECT_EQ(sa.rays, sb.rays);
+  size_t leaves = 0;
+  for (auto it = b->begin_leafs(); it != b->end_leafs(); ++it, ++leaves) {
+    const octomap::OcTreeNode* n = a->search(it.getKey());
+    ASSERT_NE(n, nullptr) << it.getCoordinate();
+    ASSERT_EQ(n->getLogOdds(), it->getLogOdds()) << it.getCoordinate();
+  }
+  EXPECT_EQ(a->getNumLeafNodes(), b->getNumLeafNodes());
+  EXPECT_GT(leaves, 1000u);
+  // Another cloud resolution: the integrator takes the points themselves.
+  VoxelCloud coarse(0.07);
+  VoxelCloud::Cells coarse_cells;
+  coarse.AddBatch(pts.p_local, pts.intensity, pts.obstacle, &coarse_cells);
+  auto c = MakeOccupancyTree(SubmapOptions{});
+  OccupancyIntegrator ic(0.1, 6.0);
+  EXPECT_EQ(ic.IntegrateCells(pts, coarse_cells, coarse.inv_resolution(), c.get()).occupied, sb.occupied);
+  EXPECT_EQ(c->getNumLeafNodes(), b->getNumLeafNodes());
+}
+
 }  // namespace
 }  // namespace cairn

@@ -24,8 +24,10 @@ OccupancyUpdateStats OpenSubmap::Integrate(const CameraPoints& pts, OccupancyInt
   if (metadata_.images == 0) metadata_.start = pts.time;
   metadata_.end = pts.time;
   ++metadata_.images;
-  cloud_.AddBatch(pts.p_local, pts.intensity, pts.obstacle);
-  return integrator->Integrate(pts, tree_.get());
+  cells_.interior.clear();
+  cells_.on_face.clear();
+  cloud_.AddBatch(pts.p_local, pts.intensity, pts.obstacle, &cells_);
+  return integrator->IntegrateCells(pts, cells_, cloud_.inv_resolution(), tree_.get());
 }
 
 std::shared_ptr<const Submap> OpenSubmap::Finish() {

@@ -60,6 +60,7 @@ class OpenSubmap {
  private:
   SubmapMetadata metadata_;
   VoxelCloud cloud_;
+  VoxelCloud::Cells cells_;  // of the last image, for the integrator
   std::unique_ptr<octomap::OcTree> tree_;
 };
 

@@ -6,7 +6,10 @@
 namespace cairn {
 
 VoxelCloud::VoxelCloud(double resolution, size_t expected_voxels)
-    : res_(resolution), inv_res_(static_cast<float>(1.0 / resolution)), voxels_(expected_voxels) {}
+    : res_(resolution),
+      inv_res_(static_cast<float>(1.0 / resolution)),
+      voxels_(expected_voxels),
+      pending_(size_t{1} << kPendingBits) {}
 
 size_t VoxelCloud::size() const {
   size_t n = 0;
@@ -54,37 +57,47 @@ void VoxelCloud::AddAll(const std::vector<CloudPoint>& points, int32_t weight) {
 }
 
 size_t VoxelCloud::AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
-                            const std::vector<uint8_t>& obstacle) {
-  size_t dropped = 0;
-  uint64_t run_key = VoxelKey::kEmpty;
-  Accum run;
-  Eigen::Vector3f corner = Eigen::Vector3f::Zero();
-  const auto flush = [&] {
-    if (run_key != VoxelKey::kEmpty) voxels_[run_key].Merge(run);
+                            const std::vector<uint8_t>& obstacle, Cells* cells) {
+  for (Pending& e : pending_) e.key = VoxelKey::kEmpty;
+  const auto flush = [&](const Pending& e) {
+    voxels_[e.key].Merge(e.sum);
+    if (cells != nullptr && e.interior) cells->interior.push_back(e.key);
   };
+  size_t dropped = 0;
+  constexpr float lim = static_cast<float>(VoxelKey::kOffset);
   for (size_t i = 0; i < p.size(); ++i) {
-    uint64_t key;
-    if (!VoxelKey::Of(p[i], inv_res_, &key)) {
+    // VoxelKey::Of, keeping the scaled coordinates for the face test.
+    const float sx = p[i].x() * inv_res_, sy = p[i].y() * inv_res_, sz = p[i].z() * inv_res_;
+    if (!(sx >= -lim && sx < lim && sy >= -lim && sy < lim && sz >= -lim && sz < lim)) {
       ++dropped;
       continue;
     }
-    if (key != run_key) {
-      flush();
-      run_key = key;
-      run = Accum{};
-      corner = VoxelKey::Unpack(key).cast<float>() * static_cast<float>(res_);
+    const int32_t kx = VoxelKey::Floor(sx), ky = VoxelKey::Floor(sy), kz = VoxelKey::Floor(sz);
+    const bool on_face = static_cast<float>(kx) == sx || static_cast<float>(ky) == sy || static_cast<float>(kz) == sz;
+    const uint64_t key = VoxelKey::Pack(kx, ky, kz);
+    Pending& e = pending_[static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - kPendingBits))];
+    if (e.key != key) {
+      if (e.key != VoxelKey::kEmpty) flush(e);
+      e.key = key;
+      e.sum = Accum{};
+      e.corner = Eigen::Vector3f(static_cast<float>(kx), static_cast<float>(ky), static_cast<float>(kz)) * static_cast<float>(res_);
+      e.interior = false;
     }
-    const Eigen::Vector3f d = p[i] - corner;
-    run.sx += d.x();
-    run.sy += d.y();
-    run.sz += d.z();
-    ++run.n;
-    run.sr += gray[i];
-    run.sg += gray[i];
-    run.sb += gray[i];
-    run.obstacles += obstacle[i] != 0;
+    e.interior = e.interior || !on_face;
+    if (cells != nullptr && on_face) cells->on_face.push_back(static_cast<uint32_t>(i));
+    const Eigen::Vector3f d = p[i] - e.corner;
+    e.sum.sx += d.x();
+    e.sum.sy += d.y();
+    e.sum.sz += d.z();
+    ++e.sum.n;
+    e.sum.sr += gray[i];
+    e.sum.sg += gray[i];
+    e.sum.sb += gray[i];
+    e.sum.obstacles += obstacle[i] != 0;
   }
-  flush();
+  for (const Pending& e : pending_) {
+    if (e.key != VoxelKey::kEmpty) flush(e);
+  }
   return dropped;
 }
 

@@ -32,10 +32,21 @@ class VoxelCloud {
   // Returns false for points outside the key range.
   bool Add(const Eigen::Vector3f& p, uint8_t r, uint8_t g, uint8_t b, bool obstacle, int32_t weight = 1);
   bool Add(const CloudPoint& c, int32_t weight = 1) { return Add(c.p, c.r, c.g, c.b, c.obstacle != 0, weight); }
-  // Gray points of one image: runs of neighbouring pixels in the same voxel are summed before one
-  // hash lookup per run (at 0.05 m a voxel spans many pixels of a row). Returns points dropped.
+  // Gray points of one image, summed per voxel in a small cache before one hash lookup per voxel
+  // and image (mostly). Returns points dropped.
+  //
+  // With `cells`, also where the points are, for an occupancy map at twice this resolution
+  // (OccupancyIntegrator::IntegrateCells): the key of each voxel that received a point strictly
+  // inside it, i.e. with p * inv_res between two integers on every axis (once per stay in the
+  // cache, so a key may repeat), and the indices of the other points, whose p * inv_res is an
+  // integer on some axis (rare; float rounding may have moved them there).
+  struct Cells {
+    std::vector<uint64_t> interior;
+    std::vector<uint32_t> on_face;
+  };
   size_t AddBatch(const std::vector<Eigen::Vector3f>& p, const std::vector<uint8_t>& gray,
-                  const std::vector<uint8_t>& obstacle);
+                  const std::vector<uint8_t>& obstacle, Cells* cells = nullptr);
+  float inv_resolution() const { return inv_res_; }
 
   // Add() of many points at once; scattered points (a moved submap's cloud) are looked up with
   // prefetching, which hides most of the cache misses of a large table.
@@ -67,10 +78,23 @@ class VoxelCloud {
   CloudPoint Centroid(uint64_t key, const Accum& a) const;
   void AddKeyed(uint64_t key, const CloudPoint& c, int32_t weight);
 
+  // Sums of one image's points per voxel before they reach the table, direct mapped by key: stereo
+  // noise moves neighbouring pixels between depth layers, so runs of one voxel along a row are
+  // short, but the few voxels a stretch of rows hits stay here, and the table (megabytes, out of
+  // the CPU caches) sees each about once per image.
+  struct Pending {
+    uint64_t key = VoxelKey::kEmpty;
+    Eigen::Vector3f corner = Eigen::Vector3f::Zero();
+    Accum sum;
+    bool interior = false;  // a point strictly inside (for Cells)
+  };
+  static constexpr int kPendingBits = 12;
+
   double res_;
   float inv_res_;
   VoxelHashMap<Accum> voxels_;
   std::vector<uint64_t> keys_;  // scratch of AddAll
+  std::vector<Pending> pending_;  // 1 << kPendingBits entries, used within AddBatch
 };
 
 }  // namespace cairn
