@@ -1,5 +1,7 @@
 #include "estimation/filter_scenario.h"
 
+#include "estimation/ordered_draws.h"
+
 #include <chrono>
 #include <cmath>
 
@@ -99,7 +101,7 @@ bool FilterScenario::Step(const std::function<void(int, double)>& timed) {
     std::normal_distribution<double> n(0.0, 1.0);
     BodyVelocity bv;
     bv.time = s.time;
-    bv.v_xy = v_body.head<2>() + Eigen::Vector2d(0.02 * n(rng_), 0.02 * n(rng_));
+    bv.v_xy = v_body.head<2>() + 0.02 * DrawVector2(n, rng_);
     bv.covariance = Eigen::Matrix2d::Identity() * 0.02 * 0.02;
     const auto a = Clock::now();
     filter_->ApplyWheelOdometry(bv);

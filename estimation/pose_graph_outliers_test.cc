@@ -9,6 +9,7 @@
 
 #include "estimation/g2o_io.h"
 #include "estimation/max_clique.h"
+#include "estimation/ordered_draws.h"
 #include "estimation/pairwise_consistency.h"
 #include "estimation/pose_graph_solver.h"
 #include "estimation/so3.h"
@@ -21,8 +22,8 @@ using Options = PoseGraphSolverOptions;
 Pose3 RandomPose(std::mt19937& rng, double extent) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> n(0.0, 1.0);
-  return {extent * Eigen::Vector3d(u(rng), u(rng), u(rng)),
-          Eigen::Quaterniond(n(rng), n(rng), n(rng), n(rng)).normalized()};
+  const Eigen::Vector3d t = extent * DrawVector3(u, rng);
+  return {t, DrawQuaternion(n, rng).normalized()};
 }
 
 // Robot `robot` drives a wavy helix of `count` poses with noisy odometry (noise as its
@@ -51,8 +52,8 @@ struct Scene {
                             so3::ExpQuaternion(Eigen::Vector3d(0.1 * std::sin(a), 0, a + M_PI / 2))};
       const uint64_t key = MakeRobotKey(robot, static_cast<uint64_t>(i));
       if (i > 0) {
-        const Pose3 noise{Eigen::Vector3d(n(rng), n(rng), n(rng)),
-                          so3::ExpQuaternion(Eigen::Vector3d(n(rng), n(rng), n(rng)))};
+        const Eigen::Vector3d dt = DrawVector3(n, rng);
+        const Pose3 noise{dt, so3::ExpQuaternion(DrawVector3(n, rng))};
         const Pose3 z = truth.back().Inverse() * (T_w_start * T_start_i) * noise;
         AddEdge(keys.back(), key, z, 0.01);
         dead_reckoning = dead_reckoning * z;

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "estimation/ordered_draws.h"
 #include "estimation/slam_graph.h"
 #include "estimation/so3.h"
 #include "estimation/topology_builder.h"
@@ -34,8 +35,8 @@ inline Scenario MakeScenario(TopologyBuilder::Topology topology, double noise, u
   std::mt19937 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   auto perturb = [&](const Pose3& p, double s) {
-    return p * Pose3{s * Eigen::Vector3d(n(rng), n(rng), n(rng)),
-                     so3::ExpQuaternion(0.1 * s * Eigen::Vector3d(n(rng), n(rng), n(rng)))};
+    const Eigen::Vector3d dt = s * DrawVector3(n, rng);
+    return p * Pose3{dt, so3::ExpQuaternion(0.1 * s * DrawVector3(n, rng))};
   };
   Scenario sc;
   const Pose3 start[2] = {P(0, 0, 0, 0), P(3, -2, 0.5, 1.0, 0.05)};

@@ -14,6 +14,7 @@
 #include "estimation/g2o_io.h"
 #include "estimation/graph_replay.h"
 #include "estimation/graph_worker.h"
+#include "estimation/ordered_draws.h"
 #include "estimation/pose_graph_solver.h"
 #include "estimation/slam_graph.h"
 #include "estimation/so3.h"
@@ -304,11 +305,15 @@ int RunGraphInject(const CommandArgs& args) {
     PoseGraphEdge e = g.edges()[closures.empty() ? template_edge(rng) : closures[template_edge(rng)]];
     e.from = g.ids()[i];
     e.to = g.ids()[j];
-    e.T_from_to.t = Eigen::Vector3d(s * uniform(rng), s * uniform(rng), planar ? 0.0 : s * uniform(rng));
+    // Last component first (estimation/ordered_draws.h).
+    const double z = planar ? 0.0 : s * uniform(rng);
+    const double y = s * uniform(rng);
+    const double x = s * uniform(rng);
+    e.T_from_to.t = Eigen::Vector3d(x, y, z);
     if (planar) {
       e.T_from_to.q = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI * uniform(rng), Eigen::Vector3d::UnitZ()));
     } else {
-      e.T_from_to.q = Eigen::Quaterniond(normal(rng), normal(rng), normal(rng), normal(rng)).normalized();
+      e.T_from_to.q = DrawQuaternion(normal, rng).normalized();
     }
     g.AddEdge(e);
   }
@@ -359,8 +364,8 @@ int RunBenchGraph(const CommandArgs& args) {
     std::normal_distribution<double> n(0.0, 1.0);
     std::uniform_int_distribution<int> pick(0, submaps - 1);
     auto noisy = [&](const Pose3& p) {
-      return p * Pose3{0.02 * Eigen::Vector3d(n(rng), n(rng), n(rng)),
-                       so3::ExpQuaternion(0.005 * Eigen::Vector3d(n(rng), n(rng), n(rng)))};
+      const Eigen::Vector3d dt = 0.02 * DrawVector3(n, rng);
+      return p * Pose3{dt, so3::ExpQuaternion(0.005 * DrawVector3(n, rng))};
     };
     // True origins: each robot drives a wavy line from its own start.
     std::vector<Pose3> truth(static_cast<size_t>(submaps));
