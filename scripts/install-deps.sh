@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   # toolchain
   build-essential cmake ninja-build pkg-config git
-  # the sanitizer builds (CI): Clang compiles them in about three quarters of GCC's time, lld links them
+  # the sanitizer builds (CI) use Clang and lld
   clang-14 lld-14 libclang-rt-14-dev
   # libraries
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
