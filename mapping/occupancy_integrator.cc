@@ -120,7 +120,7 @@ bool OccupancyIntegrator::Begin(const CameraPoints& pts, octomap::OcTree* tree) 
 
 void OccupancyIntegrator::MarkOccupied(int kx, int ky, int kz) {
   const uint64_t packed = static_cast<uint64_t>(kx) | static_cast<uint64_t>(ky) << 16 | static_cast<uint64_t>(kz) << 32;
-  uint64_t& seen = recent_[static_cast<size_t>((packed * 0x9E3779B97F4A7C15ull) >> (64 - kRecentBits))];
+  uint64_t& seen = recent_[VoxelKey::Slot(packed, kRecentBits)];
   if (seen == packed) return;
   seen = packed;
   const octomap::OcTreeKey key(static_cast<uint16_t>(kx), static_cast<uint16_t>(ky), static_cast<uint16_t>(kz));
@@ -138,8 +138,7 @@ void OccupancyIntegrator::MarkPoint(const Eigen::Vector3f& p) {
   for (int a = 0; a < 3; ++a) {
     const double s = factor_ * static_cast<double>(p[a]);
     inside = inside && s >= -kTreeMaxVal && s < kTreeMaxVal;
-    const int t = inside ? static_cast<int>(s) : 0;
-    k[a] = t - (static_cast<double>(t) > s) + kTreeMaxVal;
+    k[a] = (inside ? VoxelKey::Floor(s) : 0) + kTreeMaxVal;
   }
   if (inside) MarkOccupied(k[0], k[1], k[2]);
 }

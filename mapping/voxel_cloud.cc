@@ -75,7 +75,7 @@ size_t VoxelCloud::AddBatch(const std::vector<Eigen::Vector3f>& p, const std::ve
     const int32_t kx = VoxelKey::Floor(sx), ky = VoxelKey::Floor(sy), kz = VoxelKey::Floor(sz);
     const bool on_face = static_cast<float>(kx) == sx || static_cast<float>(ky) == sy || static_cast<float>(kz) == sz;
     const uint64_t key = VoxelKey::Pack(kx, ky, kz);
-    Pending& e = pending_[static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - kPendingBits))];
+    Pending& e = pending_[VoxelKey::Slot(key, kPendingBits)];
     if (e.key != key) {
       if (e.key != VoxelKey::kEmpty) flush(e);
       e.key = key;

@@ -40,6 +40,13 @@ struct VoxelKey {
     const int32_t t = static_cast<int32_t>(s);
     return t - (static_cast<float>(t) > s);
   }
+  static int32_t Floor(double s) {
+    const int32_t t = static_cast<int32_t>(s);
+    return t - (static_cast<double>(t) > s);
+  }
+  // Slot of a key in a direct-mapped cache of 2^bits entries (Fibonacci hashing: the high bits of
+  // the product mix every bit of the key).
+  static size_t Slot(uint64_t key, int bits) { return static_cast<size_t>((key * 0x9E3779B97F4A7C15ull) >> (64 - bits)); }
   // Cell of a point at `inv_res` cells per metre; false when outside the key range or not finite.
   static bool Of(const Eigen::Vector3f& p, float inv_res, uint64_t* key) {
     const float sx = p.x() * inv_res, sy = p.y() * inv_res, sz = p.z() * inv_res;
