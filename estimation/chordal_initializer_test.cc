@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "estimation/g2o_io.h"
+#include "estimation/ordered_draws.h"
 #include "estimation/so3.h"
 #include "tests/support/test_data.h"
 
@@ -17,7 +18,7 @@ TEST(ChordalInitializerTest, RecoversNoiseFreePosesFromGarbageEstimates) {
   std::mt19937 rng(3);
   std::normal_distribution<double> n(0.0, 1.0);
   std::vector<Pose3> truth(30);
-  for (auto& p : truth) p = {Eigen::Vector3d(5 * n(rng), 5 * n(rng), 5 * n(rng)), so3::ExpQuaternion(Eigen::Vector3d(n(rng), n(rng), n(rng)))};
+  for (auto& p : truth) p = {5 * DrawVector3(n, rng), so3::ExpQuaternion(DrawVector3(n, rng))};
   truth[0] = Pose3();
   PoseGraph g;
   for (size_t i = 0; i < truth.size(); ++i) g.SetVertex(i, Pose3{Eigen::Vector3d(n(rng), 0, 0), so3::ExpQuaternion(Eigen::Vector3d(n(rng), 0, 1))});

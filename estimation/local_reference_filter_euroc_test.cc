@@ -14,6 +14,7 @@
 
 #include "drivers/euroc_dataset.h"
 #include "estimation/local_reference_filter.h"
+#include "estimation/ordered_draws.h"
 #include "estimation/so3.h"
 
 namespace cairn {
@@ -108,7 +109,7 @@ TEST(LocalReferenceFilterEurocTest, BiasesConvergeAndAttitudeStaysAccurate) {
     while (next_gt < gt.size() && gt[next_gt].time <= s.time + Duration::Milliseconds(5)) {
       const GroundTruth& g = gt[next_gt++];
       const Eigen::Vector3d p_frame = T_world_frame.inverse() * g.p +
-                                      kSigmaPosition * Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+                                      kSigmaPosition * DrawVector3(noise, rng);
       filter.ApplyPosition(g.time, p_frame, Eigen::Matrix3d::Identity() * kSigmaPosition * kSigmaPosition);
     }
     // Compare with the ground truth at its own times through the pose history.

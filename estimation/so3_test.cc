@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "estimation/ordered_draws.h"
+
 namespace cairn {
 namespace {
 
@@ -13,7 +15,7 @@ TEST(So3Test, ExpLogRoundTripFromTinyToNearPi) {
   std::normal_distribution<double> n(0.0, 1.0);
   for (double angle : {1e-12, 1e-7, 1e-3, 0.5, 2.0, 3.1, M_PI - 1e-6}) {
     for (int i = 0; i < 20; ++i) {
-      const Eigen::Vector3d axis = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+      const Eigen::Vector3d axis = DrawVector3(n, rng).normalized();
       const Eigen::Vector3d w = angle * axis;
       EXPECT_LT((so3::Log(so3::Exp(w)) - w).norm(), 1e-9 * std::max(1.0, angle)) << angle;
     }

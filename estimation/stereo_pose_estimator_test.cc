@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimation/ordered_draws.h"
 #include "estimation/so3.h"
 #include "estimation/vo_test_scene.h"
 #include "mapping/stereo_error_model.h"
@@ -89,7 +90,7 @@ TEST(StereoPoseEstimatorTest, RecoversExactMotionDespiteOutliers) {
   Pairs pairs = MakePairs(cam, truth, 200, 0.0, 0.3, rng);
   // 30 % gross outliers: current points moved by up to a metre.
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (size_t i = 0; i < pairs.cur.size(); i += 3) pairs.cur[i].p += Eigen::Vector3d(u(rng), u(rng), u(rng));
+  for (size_t i = 0; i < pairs.cur.size(); i += 3) pairs.cur[i].p += DrawVector3(u, rng);
   VoOptions o;
   StereoPoseEstimator est(o);
   const PoseEstimate e = est.Estimate(pairs.kf, pairs.cur, 7);
