@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <sstream>
 
-#include "drivers/simulator/mission_simulator.h"
 #include "drivers/simulator/simulator_source.h"
 #include "drivers/simulator/world_file.h"
 
@@ -23,7 +22,8 @@ std::vector<std::string> SplitRobots(const std::string& list) {
 
 }  // namespace
 
-Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path) {
+Expected<std::shared_ptr<const sim::MissionSimulator>> OpenSimulatedMission(const CairndOptions& options,
+                                                                            const std::string& config_path) {
   const SimSourceOptions& o = options.sim;
   sim::WorldOptions world;
   if (!o.world.empty()) {
@@ -41,17 +41,25 @@ Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const 
   mission.render_threads = static_cast<int>(o.render_threads);
   // The simulated platform controller speaks the layout this robot's decoder expects.
   mission.can = options.can;
-  const auto it = std::find(mission.robots.begin(), mission.robots.end(), options.robot.name);
-  if (it == mission.robots.end()) {
-    return InvalidArgumentError(config_path + ": robot.name '" + options.robot.name +
-                                "' is not one of sim.robots '" + o.robots + "'");
-  }
-  const size_t index = static_cast<size_t>(it - mission.robots.begin());
   auto simulator = sim::MissionSimulator::Create(world, mission);
   if (!simulator.ok()) {
     return Status(simulator.status().code(), config_path + ": sim: " + simulator.status().message());
   }
-  std::shared_ptr<const sim::MissionSimulator> shared = std::move(*simulator);
+  return std::shared_ptr<const sim::MissionSimulator>(std::move(*simulator));
+}
+
+Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path) {
+  auto mission = OpenSimulatedMission(options, config_path);
+  if (!mission.ok()) return mission.status();
+  std::shared_ptr<const sim::MissionSimulator> shared = std::move(*mission);
+  const auto& robots = shared->robots();
+  const auto it = std::find_if(robots.begin(), robots.end(),
+                               [&](const sim::SimRobot& r) { return r.name == options.robot.name; });
+  if (it == robots.end()) {
+    return InvalidArgumentError(config_path + ": robot.name '" + options.robot.name +
+                                "' is not one of sim.robots '" + options.sim.robots + "'");
+  }
+  const size_t index = static_cast<size_t>(it - robots.begin());
 
   SimulatedRobot robot;
   const sim::SimRobot& r = shared->robots()[index];

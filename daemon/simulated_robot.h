@@ -6,6 +6,7 @@
 #include <string>
 
 #include "daemon/cairnd_options.h"
+#include "drivers/simulator/mission_simulator.h"
 #include "estimation/trajectory.h"
 #include "hal/calibration.h"
 #include "hal/sensor_source_interface.h"
@@ -20,6 +21,11 @@ struct SimulatedRobot {
   bool has_wheels = false;  // its wheel CAN frames use the configured CAN layout
   Trajectory ground_truth;  // T_world_body at every IMU sample, frame "world"
 };
+
+// The whole mission the `sim:` section describes (world, robots, duration), as the daemon plays
+// it; for scoring outputs against the world too. Errors name `config_path` and the key.
+Expected<std::shared_ptr<const sim::MissionSimulator>> OpenSimulatedMission(const CairndOptions& options,
+                                                                            const std::string& config_path);
 
 // Errors name `config_path` and the offending key (sim.world, sim.robots, robot.name).
 Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path);

@@ -15,6 +15,9 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include "daemon/cairnd_config.h"
+#include "daemon/simulated_robot.h"
+#include "drivers/simulator/surface_distance.h"
 #include "drivers/simulator/terrain.h"
 #include "drivers/simulator/world_file.h"
 #include "estimation/g2o_io.h"
@@ -138,6 +141,24 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
   // other robot are off the terrain; they are few.)
   EXPECT_LT(err[err.size() / 2], 0.05) << "median height error";
   EXPECT_LT(err[err.size() * 9 / 10], 0.15) << "90th percentile height error";
+  // The voxel map (issue 10): >= 95 % of the occupied voxels within one voxel of a true surface
+  // (the terrain, the lander, the robots where they were), as `cairn summary` scores it.
+  auto options = LoadCairndOptions(out + "/a/config.yaml", {});
+  ASSERT_TRUE(options.ok()) << options.status().ToString();
+  auto mission = OpenSimulatedMission(*options, out + "/a/config.yaml");
+  ASSERT_TRUE(mission.ok()) << mission.status().ToString();
+  const sim::SurfaceDistance surfaces(**mission, 0.1);
+  int64_t occupied = 0, near = 0;
+  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const Eigen::Vector3d c(it.getCoordinate().x(), it.getCoordinate().y(), it.getCoordinate().z());
+    ++occupied;
+    near += surfaces.Distance(T_world_first * c, tree.getResolution()) <= tree.getResolution();
+  }
+  std::printf("occupied voxels %lld, within one voxel of a true surface %.1f %%\n", static_cast<long long>(occupied),
+              100.0 * static_cast<double>(near) / static_cast<double>(std::max<int64_t>(occupied, 1)));
+  EXPECT_GT(occupied, 500);
+  EXPECT_GE(static_cast<double>(near), 0.95 * static_cast<double>(occupied));
 
   // The SLAM graph: one origin per local frame linked by the switches, sparse robot poses; it
   // places every estimate and every submap. Without loop closures its optimum is the chain of
