@@ -54,7 +54,16 @@ class ObstacleClassifier {
     uint32_t pixel;
     float ratio;  // s_min / max_slope
   };
+  struct WindowCell {
+    int cell;
+    Eigen::Vector3d p_cam;  // centre at its mean height
+  };
   void FindNegativeEdges(const DepthImage& image, const Eigen::Isometry3d& T_local_cam);
+  // Largest (h_q - h_p) / (h_max + delta_d(p, q)) over the window's pairs of a top q within
+  // step_tie_tolerance of its highest cell and a foot p within it of its lowest that rise by more
+  // than h_max; 0 when none does.
+  template <typename CentreCam>
+  double DecisivePairRatio(int gx, int gy, float zmin, float zmax, const CentreCam& centre_cam);
 
   ObstacleOptions options_;
   StereoCamera camera_;
@@ -71,6 +80,7 @@ class ObstacleClassifier {
   std::vector<int32_t> cell_of_point_;
   std::vector<int32_t> touched_;
   std::vector<uint8_t> cell_obstacle_;
+  std::vector<WindowCell> tops_, feet_;  // DecisivePairRatio's candidates, kept for their capacity
 };
 
 }  // namespace cairn
