@@ -156,6 +156,24 @@ Status ObstacleClassifier::Classify(const DepthImage& image, CameraPoints* pts, 
   }
   result->negative_edges = negative_edges;
   for (int32_t c : touched_) sum_z_[static_cast<size_t>(c)] /= static_cast<float>(count_[static_cast<size_t>(c)]);
+  // One stereo point is no estimate of its cell's mean height: such cells lie where the view grazes
+  // the surface or is cut off by an occlusion, and the lone point, from a sliver of the cell, then
+  // decides the steps of its whole window. Cells holding a negative edge stay (the edge decides).
+  const int32_t min_points = static_cast<int32_t>(options_.min_cell_points);
+  if (min_points > 1) {
+    size_t kept = 0;
+    for (int32_t c : touched_) {
+      const size_t cs = static_cast<size_t>(c);
+      if (count_[cs] >= min_points || edge_ratio_[cs] > 1.0f) {
+        touched_[kept++] = c;
+      } else {
+        sum_z_[cs] = 0.0f;
+        count_[cs] = 0;
+        edge_ratio_[cs] = 0.0f;
+      }
+    }
+    touched_.resize(kept);
+  }
 
   // Window of w cells around each observed cell: [-(w-1)/2, w/2] (even windows lean positive).
   const int w = static_cast<int>(options_.window_cells);

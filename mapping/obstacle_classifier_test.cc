@@ -1,6 +1,7 @@
 #include "mapping/obstacle_classifier.h"
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -175,6 +176,48 @@ TEST(ObstacleClassifierTest, NearExtremeCellPairsDecideStepsTheExtremePairLeaves
     total_extreme += n_extreme;
   }
   EXPECT_GT(total_tied, total_extreme + total_extreme / 4);
+}
+
+// A patch of flat ground and, beside it, one cell seen through a single pixel on top of a box
+// 0.3 m high (the rest of the box and of the ground is invalid): with min_cell_points 1 that one
+// point makes a step for the patch's cells next to it; with 2 its cell is left out and the patch
+// stays clear.
+TEST(ObstacleClassifierTest, CellsOfOnePointAreLeftOutOfTheHeightGrid) {
+  Scene s;
+  const Eigen::Isometry3d T = ForwardCameraPose({0, 0, 1.3}, 0.0, 0.44);
+  const std::vector<Box> boxes = {{2.42, 2.48, 0.02, 0.08, 0.3}};
+  DepthImage img = RenderDepth(s.cam, T, [&](const Eigen::Vector3d& o, const Eigen::Vector3d& d) {
+    return BoxesHit(o, d, boxes);
+  });
+  const PinholeRadTan& k = s.cam.intrinsics;
+  bool top_kept = false;
+  for (int v = 0; v < img.height; ++v) {
+    for (int u = 0; u < img.width; ++u) {
+      float& z = img.depth[static_cast<size_t>(v * img.width + u)];
+      const Eigen::Vector3d p = T * Eigen::Vector3d((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z);
+      const bool patch = p.z() < 0.01 && p.x() > 2.05 && p.x() < 2.4 && std::abs(p.y()) < 0.2;
+      const bool top = p.z() > 0.29 && !top_kept;
+      top_kept = top_kept || top;
+      if (!patch && !top) z = std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  ASSERT_TRUE(top_kept);
+  DepthProjector proj(s.depth_options, s.cam);
+  CameraPoints pts;
+  ObstacleResult r;
+  ASSERT_TRUE(proj.Project(img, T, &pts).ok());
+  ObstacleOptions every_cell = s.options;
+  every_cell.min_cell_points = 1;
+  ObstacleClassifier every_cls(every_cell, s.cam, proj.error_model(), proj.range());
+  ASSERT_TRUE(every_cls.Classify(img, &pts, &r).ok());
+  EXPECT_GT(CountObstacleCells(r, 2.0, 2.5), 0);
+  const size_t cells_with_lone = r.cells.size();
+  ASSERT_EQ(s.options.min_cell_points, 2);
+  ObstacleClassifier cls(s.options, s.cam, proj.error_model(), proj.range());
+  ASSERT_TRUE(cls.Classify(img, &pts, &r).ok());
+  EXPECT_EQ(CountObstacleCells(r, 0.0, 10.0), 0);
+  EXPECT_EQ(r.cells.size(), cells_with_lone - 1);
+  for (size_t i = 0; i < pts.size(); ++i) ASSERT_EQ(pts.obstacle[i], 0) << i;
 }
 
 // Flat ground seen to 9 m with stereo noise (0.25 px per pixel, independent: sub-pixel SGM noise
