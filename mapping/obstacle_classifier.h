@@ -2,7 +2,9 @@
 // Obstacle classification on one depth image (thesis 5.1.1): negative edges column by column
 // (depth jump, minimal slope eq. 5.1), then a gravity-aligned 2.5-D height grid where a cell is an
 // obstacle when the largest height difference in its window exceeds h_max + delta_d, delta_d the
-// eq. 5.4 error of the distance between the two extreme cells seen from the camera.
+// eq. 5.4 error of the distance between the two extreme cells seen from the camera, or when a pair
+// of cells within step_tie_tolerance of those two does so with its own delta_d. Cells of fewer
+// than min_cell_points points stay out of the grid.
 
 #include <cstdint>
 #include <vector>
