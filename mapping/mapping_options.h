@@ -48,6 +48,12 @@ struct ObstacleOptions {
   int64_t window_cells = 5;      // edge of the square window, 3..6 cells
   double max_step = 0.15;        // m; h_max, largest traversable step
   bool error_adaptive = true;    // false: fixed threshold h_max (for comparison)
+  // m; cells within this of the window's highest (lowest) cell are tops (feet) of its step as much
+  // as that cell is, and eq. 5.4 is taken for each such pair: the step is an obstacle when one pair
+  // exceeds h_max + its delta_d. 0: only the two extreme cells (thesis).
+  double step_tie_tolerance = 0.02;
+  // Cells with fewer points are left out of the height grid (1: every cell, as in the thesis).
+  int64_t min_cell_points = 2;
 
   void Visit(OptionsVisitor& v) {
     v.Number("edge_jump", edge_jump, 0.01, 10.0, "m");
@@ -59,6 +65,8 @@ struct ObstacleOptions {
     v.Integer("window_cells", window_cells, 3, 6, "cells");
     v.Number("max_step", max_step, 0.005, 5.0, "m");
     v.Flag("error_adaptive", error_adaptive);
+    v.Number("step_tie_tolerance", step_tie_tolerance, 0.0, 0.1, "m");
+    v.Integer("min_cell_points", min_cell_points, 1, 10000, "points");
   }
 };
 

@@ -11,7 +11,8 @@ constexpr const char* kYaml = R"(
 depth: {pixel_error_px: 0.5, min_depth: 0.3, max_depth: 8.0, max_depth_error: 0.2, far_ray_stride_px: 4,
         clear_free_beyond_range: true}
 obstacles: {edge_jump: 0.2, edge_jump_sigmas: 3.0, max_slope: 0.5, edge_max_gap_rows: 2, edge_max_range: 12.0,
-            cell_size: 0.05, window_cells: 4, max_step: 0.1, error_adaptive: true}
+            cell_size: 0.05, window_cells: 4, max_step: 0.1, error_adaptive: true, step_tie_tolerance: 0.01,
+            min_cell_points: 3}
 rolling_map: {cell_size: 0.05, cells: 400, low_pass: 0.3}
 submap: {cloud_resolution: 0.05, octree_resolution: 0.1, log_odds_hit: 0.85, log_odds_miss: -0.4,
          log_odds_min: -2.0, log_odds_max: 3.5}
@@ -26,6 +27,8 @@ TEST(MappingOptionsTest, LoadsFromYamlAndNamesBadKeys) {
   EXPECT_DOUBLE_EQ(o.partition.max_position_sigma, 0.2);
   EXPECT_EQ(o.obstacles.window_cells, 4);
   EXPECT_DOUBLE_EQ(o.obstacles.max_step, 0.1);
+  EXPECT_DOUBLE_EQ(o.obstacles.step_tie_tolerance, 0.01);
+  EXPECT_EQ(o.obstacles.min_cell_points, 3);
 
   YAML::Node bad = YAML::Load(kYaml);
   bad["obstacles"]["window_cells"] = 9;      // outside 3..6

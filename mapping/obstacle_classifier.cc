@@ -63,6 +63,38 @@ void ObstacleClassifier::FindNegativeEdges(const DepthImage& image, const Eigen:
   }
 }
 
+template <typename CentreCam>
+double ObstacleClassifier::DecisivePairRatio(int gx, int gy, float zmin, float zmax, const CentreCam& centre_cam) {
+  const int w = static_cast<int>(options_.window_cells);
+  const int lo = -(w - 1) / 2, hi = w / 2;
+  const float h_max = static_cast<float>(options_.max_step);
+  const float tol = static_cast<float>(options_.step_tie_tolerance);
+  // Of the near-extreme cells, only those more than h_max above the window's lowest can top a
+  // step, and only those more than h_max below its highest can be its foot.
+  tops_.clear();
+  feet_.clear();
+  for (int dy = lo; dy <= hi; ++dy) {
+    for (int dx = lo; dx <= hi; ++dx) {
+      const int q = (gy + dy) * n_ + gx + dx;
+      const size_t qs = static_cast<size_t>(q);
+      if (count_[qs] == 0) continue;
+      const float h = sum_z_[qs];
+      if (h >= zmax - tol && h - zmin > h_max) tops_.push_back({q, centre_cam(q)});
+      if (h <= zmin + tol && zmax - h > h_max) feet_.push_back({q, centre_cam(q)});
+    }
+  }
+  double best = 0.0;
+  for (const WindowCell& t : tops_) {
+    const float ht = sum_z_[static_cast<size_t>(t.cell)];
+    for (const WindowCell& f : feet_) {
+      const double rise = static_cast<double>(ht - sum_z_[static_cast<size_t>(f.cell)]);
+      if (rise <= options_.max_step) continue;
+      best = std::max(best, rise / (options_.max_step + model_.DistanceError(t.p_cam, f.p_cam)));
+    }
+  }
+  return best;
+}
+
 Status ObstacleClassifier::Classify(const DepthImage& image, CameraPoints* pts, ObstacleResult* result) {
   result->Clear();
   if (image.width != camera_.intrinsics.width || image.height != camera_.intrinsics.height ||
@@ -124,12 +156,35 @@ Status ObstacleClassifier::Classify(const DepthImage& image, CameraPoints* pts, 
   }
   result->negative_edges = negative_edges;
   for (int32_t c : touched_) sum_z_[static_cast<size_t>(c)] /= static_cast<float>(count_[static_cast<size_t>(c)]);
+  // One stereo point is no estimate of its cell's mean height: such cells lie where the view grazes
+  // the surface or is cut off by an occlusion, and the lone point, from a sliver of the cell, then
+  // decides the steps of its whole window. Cells holding a negative edge stay (the edge decides).
+  const int32_t min_points = static_cast<int32_t>(options_.min_cell_points);
+  if (min_points > 1) {
+    size_t kept = 0;
+    for (int32_t c : touched_) {
+      const size_t cs = static_cast<size_t>(c);
+      if (count_[cs] >= min_points || edge_ratio_[cs] > 1.0f) {
+        touched_[kept++] = c;
+      } else {
+        sum_z_[cs] = 0.0f;
+        count_[cs] = 0;
+        edge_ratio_[cs] = 0.0f;
+      }
+    }
+    touched_.resize(kept);
+  }
 
   // Window of w cells around each observed cell: [-(w-1)/2, w/2] (even windows lean positive).
   const int w = static_cast<int>(options_.window_cells);
   const int lo = -(w - 1) / 2, hi = w / 2;
   const Eigen::Isometry3d T_cam_local = pts->T_local_cam.inverse();
   const double h_max = options_.max_step;
+  // Centre of grid cell q at its mean height, in the camera frame (eq. 5.4 is in camera coordinates).
+  const auto centre_cam = [&](int q) {
+    return Eigen::Vector3d(T_cam_local * Eigen::Vector3d((ox + q % n_ + 0.5) * cell, (oy + q / n_ + 0.5) * cell,
+                                                         sum_z_[static_cast<size_t>(q)]));
+  };
   result->cells.reserve(touched_.size());
   for (int32_t c : touched_) {
     const int gx = c % n_, gy = c / n_;
@@ -148,10 +203,18 @@ Status ObstacleClassifier::Classify(const DepthImage& image, CameraPoints* pts, 
     const double h_diff = static_cast<double>(zmax - zmin);
     double threshold = h_max;
     if (options_.error_adaptive && cmax != cmin) {
-      const auto centre = [&](int q) {
-        return Eigen::Vector3d((ox + q % n_ + 0.5) * cell, (oy + q / n_ + 0.5) * cell, sum_z_[static_cast<size_t>(q)]);
-      };
-      threshold += model_.DistanceError(T_cam_local * centre(cmax), T_cam_local * centre(cmin));
+      threshold += model_.DistanceError(centre_cam(cmax), centre_cam(cmin));
+    }
+    double step_ratio = h_diff / threshold;
+    bool step_obstacle = h_diff > threshold;
+    // Eq. 5.4 depends on the two cells' placement, not only on their heights: on a rock top or a
+    // slope several cells are within noise of the highest, and which of them comes out highest is
+    // chance, yet decides delta_d (by a factor of two on the simulated rocks). A step between
+    // such near-extreme cells that exceeds h_max by more than its own delta_d is as certain.
+    if (options_.error_adaptive && options_.step_tie_tolerance > 0.0 && !step_obstacle && h_diff > h_max) {
+      const double pair_ratio = DecisivePairRatio(gx, gy, zmin, zmax, centre_cam);
+      step_ratio = std::max(step_ratio, pair_ratio);
+      step_obstacle = pair_ratio > 1.0;
     }
     const size_t cs = static_cast<size_t>(c);
     ObstacleCell out;
@@ -159,8 +222,8 @@ Status ObstacleClassifier::Classify(const DepthImage& image, CameraPoints* pts, 
     out.y = static_cast<float>((oy + gy + 0.5) * cell);
     out.height = sum_z_[cs];
     out.negative_edge = edge_ratio_[cs] > 1.0f;
-    out.traversability = std::max(static_cast<float>(h_diff / threshold), edge_ratio_[cs]);
-    out.obstacle = h_diff > threshold || out.negative_edge;
+    out.traversability = std::max(static_cast<float>(step_ratio), edge_ratio_[cs]);
+    out.obstacle = step_obstacle || out.negative_edge;
     cell_obstacle_[cs] = out.obstacle;
     result->cells.push_back(out);
   }

@@ -2,7 +2,9 @@
 // Obstacle classification on one depth image (thesis 5.1.1): negative edges column by column
 // (depth jump, minimal slope eq. 5.1), then a gravity-aligned 2.5-D height grid where a cell is an
 // obstacle when the largest height difference in its window exceeds h_max + delta_d, delta_d the
-// eq. 5.4 error of the distance between the two extreme cells seen from the camera.
+// eq. 5.4 error of the distance between the two extreme cells seen from the camera, or when a pair
+// of cells within step_tie_tolerance of those two does so with its own delta_d. Cells of fewer
+// than min_cell_points points stay out of the grid.
 
 #include <cstdint>
 #include <vector>
@@ -54,7 +56,16 @@ class ObstacleClassifier {
     uint32_t pixel;
     float ratio;  // s_min / max_slope
   };
+  struct WindowCell {
+    int cell;
+    Eigen::Vector3d p_cam;  // centre at its mean height
+  };
   void FindNegativeEdges(const DepthImage& image, const Eigen::Isometry3d& T_local_cam);
+  // Largest (h_q - h_p) / (h_max + delta_d(p, q)) over the window's pairs of a top q within
+  // step_tie_tolerance of its highest cell and a foot p within it of its lowest that rise by more
+  // than h_max; 0 when none does.
+  template <typename CentreCam>
+  double DecisivePairRatio(int gx, int gy, float zmin, float zmax, const CentreCam& centre_cam);
 
   ObstacleOptions options_;
   StereoCamera camera_;
@@ -71,6 +82,7 @@ class ObstacleClassifier {
   std::vector<int32_t> cell_of_point_;
   std::vector<int32_t> touched_;
   std::vector<uint8_t> cell_obstacle_;
+  std::vector<WindowCell> tops_, feet_;  // DecisivePairRatio's candidates, kept for their capacity
 };
 
 }  // namespace cairn
