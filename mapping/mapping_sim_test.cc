@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "drivers/simulator/surface_distance.h"
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
 #include "mapping/obstacle_ground_truth.h"
@@ -34,19 +35,6 @@ DepthImage Render(const sim::Terrain& terrain, const StereoCamera& cam, const Ei
 
 Eigen::Isometry3d CameraAt(const sim::Terrain& t, double x, double y, double yaw) {
   return ForwardCameraPose({x, y, t.Height(x, y) + 1.3}, yaw, kTilt);
-}
-
-// Distance from `c` to the true surface (dense samples within 0.2 m around it).
-double SurfaceDistance(const sim::Terrain& t, const octomap::point3d& c) {
-  double best = 1e9;
-  for (int sy = -10; sy <= 10; ++sy) {
-    for (int sx = -10; sx <= 10; ++sx) {
-      const double x = c.x() + 0.02 * sx, y = c.y() + 0.02 * sy;
-      const double dz = c.z() - t.Height(x, y);
-      best = std::min(best, std::sqrt(0.0004 * (sx * sx + sy * sy) + dz * dz));
-    }
-  }
-  return best;
 }
 
 struct SwitchRecorder : FrameSwitchRequesterInterface {
@@ -126,6 +114,7 @@ TEST(MappingSimTest, PartitionedSubmapChainRecomposesToGroundTruth) {
   composer.SetOpenSubmap(&mapper.open_submap(), T_world_frame_est);
   composer.Update();
   const auto tree = composer.Octree();
+  const sim::SurfaceDistance surface(terrain);
   int64_t occupied = 0, near = 0;
   // One voxel plus the largest drift (4 m x 0.5 % per frame, two frames chained so far).
   const double bound = o.submap.octree_resolution + 3 * 4.0 * drift;
@@ -133,7 +122,7 @@ TEST(MappingSimTest, PartitionedSubmapChainRecomposesToGroundTruth) {
     if (!tree->isNodeOccupied(*it)) continue;
     const octomap::point3d c = it.getCoordinate();
     ++occupied;
-    near += SurfaceDistance(terrain, c) <= bound;
+    near += surface.Distance(Eigen::Vector3d(c.x(), c.y(), c.z()), bound) <= bound;
   }
   std::printf("composed occupied voxels %ld, within %.3f m of the surface %.2f %%\n", static_cast<long>(occupied), bound,
               100.0 * static_cast<double>(near) / static_cast<double>(occupied));
@@ -157,12 +146,14 @@ TEST(MappingSimTest, OccupiedVoxelsLieOnTheTrueSurface) {
   }
   const auto submap = mapper.OnFrameSwitch(2, Eigen::Isometry3d::Identity());
   ASSERT_NE(submap, nullptr);
+  const sim::SurfaceDistance surface(terrain);
+  const double voxel = submap->tree().getResolution();
   int64_t occupied = 0, near = 0;
   for (auto it = submap->tree().begin_leafs(); it != submap->tree().end_leafs(); ++it) {
     if (!submap->tree().isNodeOccupied(*it)) continue;
     const octomap::point3d c = it.getCoordinate();
     ++occupied;
-    near += SurfaceDistance(terrain, c) <= submap->tree().getResolution();
+    near += surface.Distance(Eigen::Vector3d(c.x(), c.y(), c.z()), voxel) <= voxel;
   }
   std::printf("occupied voxels %ld, within one voxel of the surface %.2f %%\n", static_cast<long>(occupied),
               100.0 * static_cast<double>(near) / static_cast<double>(occupied));
