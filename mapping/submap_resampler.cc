@@ -130,7 +130,10 @@ void SubmapResampler::Resample(const octomap::OcTree& tree, const std::vector<Cl
   }
   occupancy->clear();
   occupancy->reserve(resample_.size() + touched_.size());
-  resample_.ForEach([&](uint64_t key, const Occ& o) { occupancy->emplace_back(key, o.sum / static_cast<float>(o.n)); });
+  // Mostly empty (everything in the dense grid), and a scan of its slots costs 2 MB of reads.
+  if (!resample_.empty()) {
+    resample_.ForEach([&](uint64_t key, const Occ& o) { occupancy->emplace_back(key, o.sum / static_cast<float>(o.n)); });
+  }
   if (dense) {
     for (const auto& [i, key] : touched_) {
       Occ& o = dense_[i];
