@@ -1,29 +1,18 @@
 #include "mapping/map_composer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <thread>
 
 namespace cairn {
-namespace {
-
-constexpr int kTreeMaxKey = 32768;  // OctoMap's key of coordinate 0 at depth 16
-
-// True when T maps the voxel grid onto itself (no rotation, translation a whole number of voxels),
-// so every voxel lands exactly on one global voxel.
-bool GridAligned(const Eigen::Isometry3d& T, double res) {
-  if (!T.linear().isIdentity(1e-9)) return false;
-  const Eigen::Vector3d k = T.translation() / res;
-  return (k - k.array().round().matrix()).cwiseAbs().maxCoeff() < 1e-6;
-}
-
-}  // namespace
 
 MapComposer::MapComposer(const CompositionOptions& options, const SubmapOptions& submap)
     : options_(options), submap_options_(submap), cloud_(options.cloud_resolution, 1 << 20),
       occupancy_(1 << 20), open_cloud_(options.cloud_resolution, 1 << 16), open_occupancy_(1 << 16),
-      resample_(1 << 16) {}
+      resamplers_(static_cast<size_t>(std::max<int64_t>(1, options.threads))) {}
 
 float MapComposer::Clamp(float v) const {
   return std::clamp(v, static_cast<float>(submap_options_.log_odds_min), static_cast<float>(submap_options_.log_odds_max));
@@ -74,130 +63,6 @@ bool MapComposer::Moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) 
   return d.translation().norm() > options_.rebuild_translation || angle > options_.rebuild_rotation_deg;
 }
 
-void MapComposer::Contribute(const octomap::OcTree& tree, const std::vector<CloudPoint>& points,
-                             const Eigen::Isometry3d& T, std::vector<CloudPoint>* cloud,
-                             std::vector<std::pair<uint64_t, float>>* occupancy) {
-  const Eigen::Matrix3f R = T.linear().cast<float>();
-  const Eigen::Vector3f t = T.translation().cast<float>();
-  cloud->resize(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    (*cloud)[i] = points[i];
-    (*cloud)[i].p = R * points[i].p + t;
-  }
-  // Occupancy: every finest voxel of every leaf is resampled onto the global grid. Off-grid poses
-  // use 2x2x2 samples per voxel and average what lands in each global voxel, so a rotated grid
-  // leaves no holes and counts no voxel twice.
-  const double res = tree.getResolution();
-  const float inv = static_cast<float>(1.0 / res);
-  const bool aligned = GridAligned(T, res);
-  // Gravity-aligned submaps differ by yaw only: voxel layers map onto layers, so 2 x 2 samples in
-  // x-y suffice; other rotations need 2 x 2 x 2.
-  const int samples = std::abs(T.linear()(2, 2) - 1.0) < 1e-9 ? 4 : 8;
-  const Eigen::Vector3f offsets[8] = {
-      {-0.25f, -0.25f, 0.0f},   {0.25f, -0.25f, 0.0f},   {-0.25f, 0.25f, 0.0f},   {0.25f, 0.25f, 0.0f},
-      {-0.25f, -0.25f, -0.25f}, {0.25f, -0.25f, -0.25f}, {-0.25f, 0.25f, -0.25f}, {0.25f, 0.25f, -0.25f}};
-  // Leaves first, for the bounding box of the moved tree.
-  const int tree_depth = static_cast<int>(tree.getTreeDepth());
-  leaves_.clear();
-  Eigen::Vector3i lo = Eigen::Vector3i::Constant(std::numeric_limits<int>::max()), hi = -lo;
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    const octomap::OcTreeKey k = it.getIndexKey();  // the leaf's lowest finest voxel
-    const int cells = 1 << (tree_depth - static_cast<int>(it.getDepth()));
-    const Eigen::Vector3i a(k[0] - kTreeMaxKey, k[1] - kTreeMaxKey, k[2] - kTreeMaxKey);
-    leaves_.push_back({a, cells, it->getLogOdds()});
-    lo = lo.cwiseMin(a);
-    hi = hi.cwiseMax(a + Eigen::Vector3i::Constant(cells));
-  }
-  // Samples land in a dense grid over the moved box when it is small enough (every submap made
-  // along a few metres is), which costs an index instead of a hash lookup per sample.
-  resample_.Clear();
-  bool dense = false;
-  Eigen::Vector3i g0 = Eigen::Vector3i::Zero(), dims = Eigen::Vector3i::Zero();
-  if (!leaves_.empty()) {
-    Eigen::Vector3f bmin = Eigen::Vector3f::Constant(std::numeric_limits<float>::max()), bmax = -bmin;
-    for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3f corner((c & 1 ? hi.x() : lo.x()) * static_cast<float>(res),
-                                   (c & 2 ? hi.y() : lo.y()) * static_cast<float>(res),
-                                   (c & 4 ? hi.z() : lo.z()) * static_cast<float>(res));
-      const Eigen::Vector3f g = R * corner + t;
-      bmin = bmin.cwiseMin(g);
-      bmax = bmax.cwiseMax(g);
-    }
-    const Eigen::Vector3f fmin = (bmin * inv).array().floor() - 2.0f, fmax = (bmax * inv).array().floor() + 2.0f;
-    const Eigen::Vector3f extent = fmax - fmin + Eigen::Vector3f::Ones();
-    constexpr double kMaxDenseCells = 1 << 23;
-    if ((fmin.array() > -1e6f).all() && (fmax.array() < 1e6f).all() &&
-        static_cast<double>(extent.x()) * extent.y() * extent.z() <= kMaxDenseCells) {
-      dense = true;
-      g0 = fmin.cast<int>();
-      dims = extent.cast<int>();
-      const size_t cells = static_cast<size_t>(dims.x()) * static_cast<size_t>(dims.y()) * static_cast<size_t>(dims.z());
-      if (dense_.size() < cells) dense_.resize(cells);
-      touched_.clear();
-    }
-  }
-  // Sampling works in global voxel units (g = R c + t / res with c in source voxels): no scaling
-  // per sample, and the rotated sample offsets and voxel steps are computed once.
-  const auto add = [&](const Eigen::Vector3f& g, float value) {
-    const Eigen::Vector3f f = g.array().floor();
-    if (dense) {
-      const int x = static_cast<int>(f.x()) - g0.x(), y = static_cast<int>(f.y()) - g0.y(), z = static_cast<int>(f.z()) - g0.z();
-      if (x >= 0 && y >= 0 && z >= 0 && x < dims.x() && y < dims.y() && z < dims.z()) {
-        const uint32_t i = static_cast<uint32_t>((z * dims.y() + y) * dims.x() + x);
-        Occ& o = dense_[i];
-        if (o.n == 0) touched_.push_back(i);
-        o.sum += value;
-        ++o.n;
-        return;
-      }
-    }
-    uint64_t key;
-    if (!VoxelKey::Of(f, 1.0f, &key)) return;
-    Occ& o = resample_[key];
-    o.sum += value;
-    ++o.n;
-  };
-  const Eigen::Vector3f tv = t * inv;
-  const Eigen::Vector3f step_x = R.col(0), step_y = R.col(1), step_z = R.col(2);
-  Eigen::Vector3f sample[8];
-  const int n_samples = aligned ? 1 : samples;
-  for (int si = 0; si < n_samples; ++si) {
-    // The 8-sample set: the z = -1/4 layer above plus the same x-y pattern at z = +1/4.
-    Eigen::Vector3f off = aligned ? Eigen::Vector3f::Zero() : offsets[si];
-    if (samples == 8 && si < 4) off.z() = 0.25f;
-    sample[si] = R * off;
-  }
-  for (const Leaf& leaf : leaves_) {
-    const float value = leaf.value;
-    const int cells = leaf.cells;
-    const Eigen::Vector3f base = R * (leaf.min.cast<float>() + Eigen::Vector3f::Constant(0.5f)) + tv;
-    for (int dz = 0; dz < cells; ++dz) {
-      const Eigen::Vector3f pz = base + static_cast<float>(dz) * step_z;
-      for (int dy = 0; dy < cells; ++dy) {
-        const Eigen::Vector3f py = pz + static_cast<float>(dy) * step_y;
-        for (int dx = 0; dx < cells; ++dx) {
-          const Eigen::Vector3f g = py + static_cast<float>(dx) * step_x;
-          for (int si = 0; si < n_samples; ++si) add(g + sample[si], value);
-        }
-      }
-    }
-  }
-  occupancy->clear();
-  occupancy->reserve(resample_.size() + touched_.size());
-  resample_.ForEach([&](uint64_t key, const Occ& o) { occupancy->emplace_back(key, o.sum / static_cast<float>(o.n)); });
-  if (dense) {
-    for (const uint32_t i : touched_) {
-      Occ& o = dense_[i];
-      const int x = static_cast<int>(i % static_cast<uint32_t>(dims.x()));
-      const int y = static_cast<int>(i / static_cast<uint32_t>(dims.x()) % static_cast<uint32_t>(dims.y()));
-      const int z = static_cast<int>(i / (static_cast<uint32_t>(dims.x()) * static_cast<uint32_t>(dims.y())));
-      occupancy->emplace_back(VoxelKey::Pack(g0.x() + x, g0.y() + y, g0.z() + z), o.sum / static_cast<float>(o.n));
-      o = Occ{};
-    }
-    touched_.clear();
-  }
-}
-
 void MapComposer::Apply(const Entry& e, int sign) {
   cloud_.AddAll(e.cloud, sign);
   const float s = static_cast<float>(sign);
@@ -213,25 +78,66 @@ void MapComposer::Apply(const Entry& e, int sign) {
   }
 }
 
+void MapComposer::ResampleAndApply(const std::vector<Entry*>& entries) {
+  // Resampling is independent per submap and most of a rebuild's time; the running sums are
+  // shared. So helpers resample while this thread adds the finished contributions, in entry order
+  // (the order of the float sums stays that of a single thread), and resamples itself whenever
+  // the next one in order is not ready. Entries are handed out one at a time: submaps differ in
+  // size, and a busy core gets fewer.
+  const size_t n = entries.size();
+  std::atomic<size_t> next{0};
+  std::vector<std::atomic<bool>> done(n);
+  const auto resample = [&](SubmapResampler& r, size_t i) {
+    Entry& e = *entries[i];
+    r.Resample(e.submap->tree(), e.submap->points(), e.pose_target, &e.cloud, &e.occupancy);
+    done[i].store(true, std::memory_order_release);
+    done[i].notify_one();
+  };
+  const size_t helpers = n == 0 ? 0 : std::min(resamplers_.size(), n) - 1;
+  std::vector<std::thread> threads;
+  threads.reserve(helpers);
+  for (size_t t = 1; t <= helpers; ++t) {
+    threads.emplace_back([&, t] {
+      for (size_t i = next++; i < n; i = next++) resample(resamplers_[t], i);
+    });
+  }
+  for (size_t applied = 0; applied < n;) {
+    if (!done[applied].load(std::memory_order_acquire)) {
+      const size_t i = next++;
+      if (i < n) {
+        resample(resamplers_[0], i);
+      } else {
+        done[applied].wait(false, std::memory_order_acquire);
+      }
+      continue;
+    }
+    Entry& e = *entries[applied++];
+    e.pose_applied = e.pose_target;
+    e.applied = true;
+    Apply(e, +1);
+  }
+  for (std::thread& t : threads) t.join();
+}
+
 CompositionStats MapComposer::Update() {
   CompositionStats stats;
+  std::vector<Entry*> stale;
   for (auto& [ref, e] : entries_) {
     if (e.applied && !Moved(e.pose_applied, e.pose_target)) {
       ++stats.cached;
       continue;
     }
     if (e.applied) Apply(e, -1);
-    Contribute(e.submap->tree(), e.submap->points(), e.pose_target, &e.cloud, &e.occupancy);
-    e.pose_applied = e.pose_target;
-    e.applied = true;
-    Apply(e, +1);
-    ++stats.rebuilt;
+    e.applied = false;
+    stale.push_back(&e);
   }
+  ResampleAndApply(stale);
+  stats.rebuilt = static_cast<int>(stale.size());
   open_cloud_.Clear();
   open_occupancy_.Clear();
   if (open_ != nullptr) {
     // The open tree's inner nodes are stale (lazy updates), but only leaves are read.
-    Contribute(open_->tree(), open_->cloud().Points(), open_pose_, &open_points_, &open_pairs_);
+    resamplers_[0].Resample(open_->tree(), open_->cloud().Points(), open_pose_, &open_points_, &open_pairs_);
     open_cloud_.AddAll(open_points_, 1);
     for (const auto& [key, value] : open_pairs_) open_occupancy_[key] = value;
   }
@@ -266,9 +172,10 @@ std::unique_ptr<octomap::OcTree> MapComposer::Octree() const {
   auto tree = MakeOccupancyTree(submap_options_);
   const auto put = [&](uint64_t key, float value) {
     const Eigen::Vector3i c = VoxelKey::Unpack(key);
-    if ((c.array().abs() >= kTreeMaxKey).any()) return;  // beyond OctoMap's key range
-    const octomap::OcTreeKey k(static_cast<uint16_t>(c.x() + kTreeMaxKey), static_cast<uint16_t>(c.y() + kTreeMaxKey),
-                               static_cast<uint16_t>(c.z() + kTreeMaxKey));
+    if ((c.array().abs() >= SubmapResampler::kTreeMaxKey).any()) return;  // beyond OctoMap's key range
+    constexpr int kMax = SubmapResampler::kTreeMaxKey;
+    const octomap::OcTreeKey k(static_cast<uint16_t>(c.x() + kMax), static_cast<uint16_t>(c.y() + kMax),
+                               static_cast<uint16_t>(c.z() + kMax));
     tree->setNodeValue(k, Clamp(value), true);
   };
   occupancy_.ForEach([&](uint64_t key, const Occ& o) {

@@ -23,6 +23,7 @@
 #include "hal/status.h"
 #include "mapping/mapping_options.h"
 #include "mapping/submap.h"
+#include "mapping/submap_resampler.h"
 #include "mapping/voxel_cloud.h"
 #include "mapping/voxel_hash_map.h"
 
@@ -80,9 +81,9 @@ class MapComposer {
     std::vector<std::pair<uint64_t, float>> occupancy;  // global voxel, resampled log-odds
   };
   bool Moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
-  void Contribute(const octomap::OcTree& tree, const std::vector<CloudPoint>& points,
-                  const Eigen::Isometry3d& T, std::vector<CloudPoint>* cloud,
-                  std::vector<std::pair<uint64_t, float>>* occupancy);
+  // Resamples the entries at their target poses (on up to options_.threads threads) and adds
+  // their contributions.
+  void ResampleAndApply(const std::vector<Entry*>& entries);
   void Apply(const Entry& e, int sign);
   float Clamp(float v) const;
 
@@ -97,16 +98,8 @@ class MapComposer {
   Eigen::Isometry3d open_pose_ = Eigen::Isometry3d::Identity();
   VoxelCloud open_cloud_;
   VoxelHashMap<float> open_occupancy_;
-  // Scratch.
-  struct Leaf {
-    Eigen::Vector3i min;  // lowest finest voxel, signed grid index
-    int cells;            // finest voxels per side
-    float value;
-  };
-  std::vector<Leaf> leaves_;
-  std::vector<Occ> dense_;         // resampling grid over a moved submap's box, all zero between uses
-  std::vector<uint32_t> touched_;  // its cells in use
-  VoxelHashMap<Occ> resample_;     // samples outside the dense grid
+  // One per thread (options_.threads); the first also resamples the open submap.
+  std::vector<SubmapResampler> resamplers_;
   std::vector<CloudPoint> open_points_;
   std::vector<std::pair<uint64_t, float>> open_pairs_;
 };

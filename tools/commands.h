@@ -6,6 +6,9 @@ namespace cairn::tools {
 
 // CPU time of the calling thread in ms: on a loaded machine it still measures one core's work.
 double ThreadCpuMs();
+// CPU time of the whole process (all threads) in ms: unlike wall time it barely depends on what
+// else runs on the machine, so it still compares work spread over threads when cores are shared.
+double ProcessCpuMs();
 
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);

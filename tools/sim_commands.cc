@@ -90,11 +90,16 @@ Expected<CanWheelOptions> LoadCanLayout(const std::string& requested) {
 
 }  // namespace
 
-double ThreadCpuMs() {
+namespace {
+double CpuMs(clockid_t clock) {
   timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  clock_gettime(clock, &ts);
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
+}  // namespace
+
+double ThreadCpuMs() { return CpuMs(CLOCK_THREAD_CPUTIME_ID); }
+double ProcessCpuMs() { return CpuMs(CLOCK_PROCESS_CPUTIME_ID); }
 
 int RunSim(const CommandArgs& args) {
   std::string world_path, out, rover_config;

@@ -162,14 +162,6 @@ bool ParseSgmOptions(const ArgMap& a, SgmOptions* o) {
   return true;
 }
 
-// CPU time of the whole process (all threads): unlike wall time it barely depends on what else
-// runs on the machine, so it still compares the matchers when the cores are shared.
-double ProcessCpuMs() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
 double MedianMs(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];

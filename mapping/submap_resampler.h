@@ -1,0 +1,46 @@
+#pragma once
+// One submap's contribution to the composed map (thesis 5.2.2): its cloud moved by a pose and its
+// occupancy tree resampled onto the global voxel grid. Each instance keeps its own scratch, so
+// several threads can resample different submaps at once, one resampler each.
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <octomap/OcTree.h>
+
+#include "mapping/voxel_cloud.h"
+#include "mapping/voxel_hash_map.h"
+
+namespace cairn {
+
+class SubmapResampler {
+ public:
+  static constexpr int kTreeMaxKey = 32768;  // OctoMap's key of coordinate 0 at depth 16
+
+  // `cloud`: the points moved by T_global_submap. `occupancy`: every global voxel the tree's
+  // leaves cover (VoxelKey at the tree's resolution) with the mean log-odds of what lands in it.
+  void Resample(const octomap::OcTree& tree, const std::vector<CloudPoint>& points,
+                const Eigen::Isometry3d& T_global_submap, std::vector<CloudPoint>* cloud,
+                std::vector<std::pair<uint64_t, float>>* occupancy);
+
+ private:
+  struct Occ {
+    float sum = 0.0f;
+    int32_t n = 0;
+  };
+  struct Leaf {
+    Eigen::Vector3i min;  // lowest finest voxel, signed grid index
+    int cells;            // finest voxels per side
+    float value;
+  };
+  std::vector<Leaf> leaves_;
+  std::vector<Occ> dense_;  // resampling grid over a moved submap's box, all zero between uses
+  // Its cells in use and their global keys (computing a key back from a cell took three
+  // divisions per voxel).
+  std::vector<std::pair<uint32_t, uint64_t>> touched_;
+  VoxelHashMap<Occ> resample_{1 << 16};  // samples outside the dense grid
+};
+
+}  // namespace cairn
