@@ -1,18 +1,15 @@
 #include "mapping/map_composer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <thread>
 
 namespace cairn {
 
 MapComposer::MapComposer(const CompositionOptions& options, const SubmapOptions& submap)
     : options_(options), submap_options_(submap), cloud_(options.cloud_resolution, 1 << 20),
-      occupancy_(1 << 20), open_cloud_(options.cloud_resolution, 1 << 16), open_occupancy_(1 << 16),
-      resamplers_(static_cast<size_t>(std::max<int64_t>(1, options.threads))) {}
+      occupancy_(1 << 20), open_cloud_(options.cloud_resolution, 1 << 16), open_occupancy_(1 << 16) {}
 
 float MapComposer::Clamp(float v) const {
   return std::clamp(v, static_cast<float>(submap_options_.log_odds_min), static_cast<float>(submap_options_.log_odds_max));
@@ -79,44 +76,12 @@ void MapComposer::Apply(const Entry& e, int sign) {
 }
 
 void MapComposer::ResampleAndApply(const std::vector<Entry*>& entries) {
-  // Resampling is independent per submap and most of a rebuild's time; the running sums are
-  // shared. So helpers resample while this thread adds the finished contributions, in entry order
-  // (the order of the float sums stays that of a single thread), and resamples itself whenever
-  // the next one in order is not ready. Entries are handed out one at a time: submaps differ in
-  // size, and a busy core gets fewer.
-  const size_t n = entries.size();
-  std::atomic<size_t> next{0};
-  std::vector<std::atomic<bool>> done(n);
-  const auto resample = [&](SubmapResampler& r, size_t i) {
-    Entry& e = *entries[i];
-    r.Resample(e.submap->tree(), e.submap->points(), e.pose_target, &e.cloud, &e.occupancy);
-    done[i].store(true, std::memory_order_release);
-    done[i].notify_one();
-  };
-  const size_t helpers = n == 0 ? 0 : std::min(resamplers_.size(), n) - 1;
-  std::vector<std::thread> threads;
-  threads.reserve(helpers);
-  for (size_t t = 1; t <= helpers; ++t) {
-    threads.emplace_back([&, t] {
-      for (size_t i = next++; i < n; i = next++) resample(resamplers_[t], i);
-    });
+  for (Entry* e : entries) {
+    resampler_.Resample(e->submap->tree(), e->submap->points(), e->pose_target, &e->cloud, &e->occupancy);
+    e->pose_applied = e->pose_target;
+    e->applied = true;
+    Apply(*e, +1);
   }
-  for (size_t applied = 0; applied < n;) {
-    if (!done[applied].load(std::memory_order_acquire)) {
-      const size_t i = next++;
-      if (i < n) {
-        resample(resamplers_[0], i);
-      } else {
-        done[applied].wait(false, std::memory_order_acquire);
-      }
-      continue;
-    }
-    Entry& e = *entries[applied++];
-    e.pose_applied = e.pose_target;
-    e.applied = true;
-    Apply(e, +1);
-  }
-  for (std::thread& t : threads) t.join();
 }
 
 CompositionStats MapComposer::Update() {
@@ -137,7 +102,7 @@ CompositionStats MapComposer::Update() {
   open_occupancy_.Clear();
   if (open_ != nullptr) {
     // The open tree's inner nodes are stale (lazy updates), but only leaves are read.
-    resamplers_[0].Resample(open_->tree(), open_->cloud().Points(), open_pose_, &open_points_, &open_pairs_);
+    resampler_.Resample(open_->tree(), open_->cloud().Points(), open_pose_, &open_points_, &open_pairs_);
     open_cloud_.AddAll(open_points_, 1);
     for (const auto& [key, value] : open_pairs_) open_occupancy_[key] = value;
   }

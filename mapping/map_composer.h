@@ -81,8 +81,7 @@ class MapComposer {
     std::vector<std::pair<uint64_t, float>> occupancy;  // global voxel, resampled log-odds
   };
   bool Moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
-  // Resamples the entries at their target poses (on up to options_.threads threads) and adds
-  // their contributions.
+  // Resamples the entries at their target poses and adds their contributions.
   void ResampleAndApply(const std::vector<Entry*>& entries);
   void Apply(const Entry& e, int sign);
   float Clamp(float v) const;
@@ -98,8 +97,7 @@ class MapComposer {
   Eigen::Isometry3d open_pose_ = Eigen::Isometry3d::Identity();
   VoxelCloud open_cloud_;
   VoxelHashMap<float> open_occupancy_;
-  // One per thread (options_.threads); the first also resamples the open submap.
-  std::vector<SubmapResampler> resamplers_;
+  SubmapResampler resampler_;
   std::vector<CloudPoint> open_points_;
   std::vector<std::pair<uint64_t, float>> open_pairs_;
 };

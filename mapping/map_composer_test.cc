@@ -1,12 +1,8 @@
 #include "mapping/map_composer.h"
 
-#include <algorithm>
-#include <array>
 #include <cmath>
 #include <unordered_map>
 #include <numbers>
-#include <utility>
-#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -149,40 +145,6 @@ TEST(MapComposerTest, OpenSubmapIsMergedButNeverCached) {
   composer.SetOpenSubmap(nullptr, Eigen::Isometry3d::Identity());
   composer.Update();
   EXPECT_TRUE(std::isnan(composer.LogOdds({22.05, 0.05, 0.05})));
-}
-
-// Resampling on several threads adds the contributions in the same order as one thread: the
-// composed maps are identical to the bit, also with more threads than submaps to resample.
-TEST(MapComposerTest, ThreadedRebuildEqualsSingleThreaded) {
-  SubmapOptions so;
-  std::vector<std::shared_ptr<const Submap>> maps;
-  for (uint64_t i = 0; i < 5; ++i) maps.push_back(testing::SyntheticSubmap(i, 1, static_cast<unsigned>(i + 7)));
-  const auto compose = [&](int64_t threads, size_t count) {
-    CompositionOptions co;
-    co.threads = threads;
-    MapComposer composer(co, so);
-    for (size_t i = 0; i < count; ++i) {
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      T.linear() = Eigen::AngleAxisd(0.4 * static_cast<double>(i), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      T.translation() = Eigen::Vector3d(2.0 * static_cast<double>(i), 0.3, 0.01 * static_cast<double>(i));
-      EXPECT_TRUE(composer.SetSubmap(maps[i], T).ok());
-    }
-    EXPECT_EQ(composer.Rebuild().rebuilt, static_cast<int>(count));
-    std::vector<std::array<float, 4>> cloud;
-    for (const CloudPoint& c : composer.Cloud()) cloud.push_back({c.p.x(), c.p.y(), c.p.z(), static_cast<float>(c.r)});
-    std::sort(cloud.begin(), cloud.end());
-    return std::make_pair(cloud, Voxels(*composer.Octree()));
-  };
-  for (const size_t count : {size_t{1}, size_t{5}}) {
-    const auto [cloud1, voxels1] = compose(1, count);
-    for (const int64_t threads : {2, 3, 8}) {
-      const auto [cloud, voxels] = compose(threads, count);
-      EXPECT_EQ(cloud, cloud1) << threads << " threads, " << count << " submaps";
-      ASSERT_EQ(voxels.size(), voxels1.size());
-      for (const auto& [k, v] : voxels1) ASSERT_EQ(voxels.at(k), v) << threads << " threads";
-    }
-    EXPECT_GT(voxels1.size(), 500u * count);
-  }
 }
 
 TEST(MapComposerTest, RejectsMismatchedResolution) {

@@ -121,15 +121,11 @@ struct CompositionOptions {
   // A cached submap contribution is rebuilt when its origin moved by more than this...
   double rebuild_translation = 0.02;  // m
   double rebuild_rotation_deg = 0.2;  // deg
-  // Threads resampling moved submaps (the bulk of a full rebuild); they run where the calling
-  // executor may (its CPUs and priority).
-  int64_t threads = 2;
 
   void Visit(OptionsVisitor& v) {
     v.Number("cloud_resolution", cloud_resolution, 0.005, 1.0, "m");
     v.Number("rebuild_translation", rebuild_translation, 0.0, 10.0, "m");
     v.Number("rebuild_rotation_deg", rebuild_rotation_deg, 0.0, 180.0, "deg");
-    v.Integer("threads", threads, 1, 16, "");
   }
 };
 

@@ -17,7 +17,7 @@ rolling_map: {cell_size: 0.05, cells: 400, low_pass: 0.3}
 submap: {cloud_resolution: 0.05, octree_resolution: 0.1, log_odds_hit: 0.85, log_odds_miss: -0.4,
          log_odds_min: -2.0, log_odds_max: 3.5}
 partition: {max_position_sigma: 0.2, max_distance: 7.0, retry_interval: 1.0}
-composition: {cloud_resolution: 0.05, rebuild_translation: 0.02, rebuild_rotation_deg: 0.2, threads: 2}
+composition: {cloud_resolution: 0.05, rebuild_translation: 0.02, rebuild_rotation_deg: 0.2}
 )";
 
 TEST(MappingOptionsTest, LoadsFromYamlAndNamesBadKeys) {
