@@ -51,16 +51,15 @@ std::vector<double> LoopClosureChi2(const PoseGraph& graph) {
 // off (F(s) high), one too narrow leaves true closures unsatisfied (also high) or nearly fits the
 // true ones (low), and F is found decreasing around its fixed point on every graph tried: the
 // fixed point is bracketed from s = 1 and F(1), then bisected in log s to a factor of two. Solves
-// of a copy of `graph`, from odometry, each warm-started at the last.
-Expected<double> RobustNoiseScale(const PoseGraph& graph, const PoseGraphSolverOptions& options) {
+// of `robust_graph`, from odometry, each warm-started at the last; it is left at the last one.
+Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolverOptions& options) {
   constexpr int kSolves = 10;
-  PoseGraph robust_graph = graph;
   PoseGraphSolverOptions robust = options;
   robust.outliers = PoseGraphSolverOptions::Outliers::kNone;
   if (options.init != PoseGraphSolverOptions::Init::kFile) robust.init = PoseGraphSolverOptions::Init::kOdometry;
   robust.function_tolerance = std::max(options.function_tolerance, 1e-6);
   robust.verbose = false;
-  const int dof = graph.planar() ? 3 : 6;
+  const int dof = robust_graph.planar() ? 3 : 6;
   int solves = 0;
   auto estimate_at = [&](double scale) -> Expected<double> {
     robust.cauchy_c = std::sqrt(scale);
@@ -100,12 +99,19 @@ Expected<double> RobustNoiseScale(const PoseGraph& graph, const PoseGraphSolverO
 // GNC with the estimated noise scale (see SolvePoseGraph in the header).
 Expected<PoseGraphSolveSummary> SolveWithEstimatedScale(PoseGraph& graph, const PoseGraphSolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  auto scale = RobustNoiseScale(graph, options);
+  PoseGraph robust = graph;
+  auto scale = RobustNoiseScale(robust, options);
   if (!scale.ok()) return scale.status();
   const double scale_seconds = Seconds(start);
   PoseGraphSolverOptions gnc = options;
   gnc.noise_scale = *scale;
+  // GNC's warm start is the Cauchy solve at that scale: from the last one there, not from odometry.
+  const bool had_estimate = graph.has_initial_estimate();
+  graph.poses() = robust.poses();
+  graph.set_has_initial_estimate(true);
+  gnc.init = PoseGraphSolverOptions::Init::kFile;
   auto summary = SolvePoseGraph(graph, gnc);
+  graph.set_has_initial_estimate(had_estimate);
   if (!summary.ok()) return summary.status();
   summary->scale_seconds = scale_seconds;
   summary->init_seconds += scale_seconds;
