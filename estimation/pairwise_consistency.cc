@@ -7,6 +7,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "estimation/noise_scale.h"
 #include "estimation/so3.h"
 
 namespace cairn {
@@ -46,20 +47,22 @@ struct Closure {
 
 }  // namespace
 
-double ChiSquareQuantile(double probability, int dof) {
+double ChiSquareCdf(double x, int dof) {
   // Upper tail Q(x; k) by the recurrence Q(k + 2) = Q(k) + (x/2)^(k/2) e^(-x/2) / Gamma(k/2 + 1).
-  auto upper = [dof](double x) {
-    double q = dof % 2 == 0 ? std::exp(-0.5 * x) : std::erfc(std::sqrt(0.5 * x));
-    for (int k = dof % 2 == 0 ? 2 : 1; k + 2 <= dof; k += 2) {
-      const double h = 0.5 * k;
-      q += std::exp(h * std::log(0.5 * x) - 0.5 * x - std::lgamma(h + 1.0));
-    }
-    return q;
-  };
+  if (!(x > 0.0)) return 0.0;
+  double q = dof % 2 == 0 ? std::exp(-0.5 * x) : std::erfc(std::sqrt(0.5 * x));
+  for (int k = dof % 2 == 0 ? 2 : 1; k + 2 <= dof; k += 2) {
+    const double h = 0.5 * k;
+    q += std::exp(h * std::log(0.5 * x) - 0.5 * x - std::lgamma(h + 1.0));
+  }
+  return 1.0 - q;
+}
+
+double ChiSquareQuantile(double probability, int dof) {
   double lo = 0.0, hi = 10.0 * dof + 100.0;
   for (int i = 0; i < 200; ++i) {
     const double mid = 0.5 * (lo + hi);
-    (1.0 - upper(mid) < probability ? lo : hi) = mid;
+    (ChiSquareCdf(mid, dof) < probability ? lo : hi) = mid;
   }
   return 0.5 * (lo + hi);
 }
@@ -71,7 +74,9 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
   }
   PairwiseConsistencyResult result;
   result.keep.assign(graph.edges().size(), true);
-  result.threshold = ChiSquareQuantile(options.confidence, graph.planar() ? 3 : 6);
+  const int dof = graph.planar() ? 3 : 6;
+  result.noise_scale = options.noise_scale > 0.0 ? options.noise_scale : 1.0;
+  result.threshold = result.noise_scale * ChiSquareQuantile(options.confidence, dof);
 
   // Chains: walk the vertices in key order; a vertex continues its predecessor's chain when an
   // odometry edge joins them (the first one, should there be several).
@@ -129,11 +134,14 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
   }
   result.groups = static_cast<int>(groups.size());
 
+  // Squared Mahalanobis length of every pair's cycle, per group in pair order (i < j).
+  std::vector<std::vector<float>> cycle_chi2;
   for (const auto& [chain_pair, closures] : groups) {
     const Chain& r = chains[static_cast<size_t>(chain_pair.first)];
     const Chain& s = chains[static_cast<size_t>(chain_pair.second)];
     const bool one_chain = chain_pair.first == chain_pair.second;
-    BitRows consistent = MakeBitRows(closures.size());
+    std::vector<float>& d2 = cycle_chi2.emplace_back();
+    d2.reserve(closures.size() * (closures.size() - 1) / 2);
     for (size_t i = 0; i < closures.size(); ++i) {
       const Closure& ci = closures[i];
       const Pose3& T_r_xi = r.T_c_v[static_cast<size_t>(ci.x)];
@@ -153,10 +161,33 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
         const Matrix6d Ss = s.Segment(ci.y, cj.y);
         S += one_chain ? Ss : Matrix6d(A_r_s * Ss * A_r_s.transpose());
         const Eigen::LDLT<Matrix6d> ldlt(S);
-        if (e_r.dot(ldlt.solve(e_r)) <= result.threshold) SetEdge(consistent, i, j);
+        d2.push_back(static_cast<float>(e_r.dot(ldlt.solve(e_r))));
       }
     }
-    result.pairs_tested += static_cast<int64_t>(closures.size() * (closures.size() - 1) / 2);
+    result.pairs_tested += static_cast<int64_t>(d2.size());
+  }
+  if (options.noise_scale <= 0.0) {
+    // The cycles' own scale: most pairs are of two true closures while false ones are a minority.
+    // A million pairs at most, evenly strided: quantiles to far better than the fit needs.
+    const size_t stride = static_cast<size_t>(result.pairs_tested / 1000000 + 1);
+    std::vector<double> all;
+    for (const auto& d2 : cycle_chi2) {
+      for (size_t k = 0; k < d2.size(); k += stride) all.push_back(d2[k]);
+    }
+    const NoiseScaleEstimate estimate = EstimateNoiseScale(all, dof, options.confidence);
+    result.noise_scale = estimate.scale;
+    result.threshold = estimate.threshold;
+  }
+
+  size_t group = 0;
+  for (const auto& [chain_pair, closures] : groups) {
+    const std::vector<float>& d2 = cycle_chi2[group++];
+    BitRows consistent = MakeBitRows(closures.size());
+    for (size_t i = 0, pair = 0; i < closures.size(); ++i) {
+      for (size_t j = i + 1; j < closures.size(); ++j, ++pair) {
+        if (d2[pair] <= result.threshold) SetEdge(consistent, i, j);
+      }
+    }
     const CliqueResult clique = MaximumClique(consistent, options.clique);
     result.exact = result.exact && clique.exact;
     std::vector<bool> in_clique(closures.size(), false);

@@ -27,6 +27,12 @@ namespace cairn {
 
 struct PairwiseConsistencyOptions {
   double confidence = 0.99;  // chi-square probability of the pairwise test
+  // Factor by which the true noise variance exceeds the one the information matrices state (see
+  // noise_scale.h): every covariance of a cycle scales by it, so the threshold does. 0 = estimated
+  // from the cycles' squared Mahalanobis lengths (the robust log-normal fit of noise_scale.h, its
+  // quantile at `confidence` the threshold): the cycle test's own statistic, so that it also
+  // absorbs odometry and closures misstated by different factors.
+  double noise_scale = 1.0;
   CliqueOptions clique;
 };
 
@@ -37,9 +43,12 @@ struct PairwiseConsistencyResult {
   int groups = 0;
   bool exact = true;           // every group's clique is provably maximum
   double threshold = 0.0;      // on the squared Mahalanobis length of a cycle
+  double noise_scale = 1.0;    // given or estimated
   int64_t pairs_tested = 0;
 };
 
+// Cumulative distribution of the chi-square distribution (integer dof >= 1) at x >= 0.
+double ChiSquareCdf(double x, int dof);
 // Quantile of the chi-square distribution (integer dof >= 1), by bisection on its CDF.
 double ChiSquareQuantile(double probability, int dof);
 

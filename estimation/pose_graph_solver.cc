@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "estimation/chordal_initializer.h"
+#include "estimation/noise_scale.h"
 #include "estimation/pairwise_consistency.h"
 #include "estimation/pose_factors.h"
 
@@ -33,6 +34,90 @@ PoseGraph KeptEdges(const PoseGraph& graph, const std::vector<bool>& keep) {
   return kept;
 }
 
+// Squared whitened geodesic residual of every loop closure of `graph` at its vertex estimates.
+std::vector<double> LoopClosureChi2(const PoseGraph& graph) {
+  std::vector<double> r2;
+  for (const auto& e : graph.edges()) {
+    if (!IsLoopClosure(e)) continue;
+    const Vector6d r = GeodesicError(graph.poses()[graph.Find(e.from)], graph.poses()[graph.Find(e.to)], e.T_from_to);
+    r2.push_back(r.dot(e.information * r));
+  }
+  return r2;
+}
+
+// The noise scale (noise_scale.h) as the fixed point s = F(s) of F(s), the estimate from the loop
+// closures' residuals at the Cauchy solution with c = sqrt(s) (the loss's knee at a squared
+// residual of s, 1 in the units of the noise): a loss too wide lets false closures drag true ones
+// off (F(s) high), one too narrow leaves true closures unsatisfied (also high) or nearly fits the
+// true ones (low), and F is found decreasing around its fixed point on every graph tried: the
+// fixed point is bracketed from s = 1 and F(1), then bisected in log s to a factor of two. Solves
+// of `robust_graph`, from odometry, each warm-started at the last; it is left at the last one.
+Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolverOptions& options) {
+  constexpr int kSolves = 10;
+  PoseGraphSolverOptions robust = options;
+  robust.outliers = PoseGraphSolverOptions::Outliers::kNone;
+  if (options.init != PoseGraphSolverOptions::Init::kFile) robust.init = PoseGraphSolverOptions::Init::kOdometry;
+  robust.function_tolerance = std::max(options.function_tolerance, 1e-6);
+  robust.verbose = false;
+  const int dof = robust_graph.planar() ? 3 : 6;
+  int solves = 0;
+  auto estimate_at = [&](double scale) -> Expected<double> {
+    robust.cauchy_c = std::sqrt(scale);
+    auto s = SolvePoseGraph(robust_graph, robust);
+    if (!s.ok()) return s.status();
+    robust.init = PoseGraphSolverOptions::Init::kFile;
+    robust_graph.set_has_initial_estimate(true);
+    ++solves;
+    const double next = EstimateNoiseScale(LoopClosureChi2(robust_graph), dof, kResidualConfidence).scale;
+    if (options.verbose) std::fprintf(stderr, "noise scale: Cauchy c^2 %.4g gives %.4g\n", scale, next);
+    return next;
+  };
+  // g(s) = log F(s) - log s: positive below the fixed point, negative above.
+  double a = 1.0;
+  auto fa = estimate_at(a);
+  if (!fa.ok()) return fa.status();
+  double b = *fa;
+  while (solves < kSolves) {
+    if (b > 0.5 * a && b < 2.0 * a) return std::sqrt(a * b);
+    auto fb = estimate_at(b);
+    if (!fb.ok()) return fb.status();
+    if ((*fa > a) != (*fb > b)) break;  // bracketed
+    a = b;
+    fa = fb;
+    b = *fb;
+  }
+  // Bisection of [a, b] in log s.
+  while (solves < kSolves && std::abs(std::log(b / a)) > std::log(2.0)) {
+    const double m = std::sqrt(a * b);
+    auto fm = estimate_at(m);
+    if (!fm.ok()) return fm.status();
+    ((*fm > m) == (*fa > a) ? a : b) = m;
+  }
+  return std::sqrt(a * b);
+}
+
+// GNC with the estimated noise scale (see SolvePoseGraph in the header).
+Expected<PoseGraphSolveSummary> SolveWithEstimatedScale(PoseGraph& graph, const PoseGraphSolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PoseGraph robust = graph;
+  auto scale = RobustNoiseScale(robust, options);
+  if (!scale.ok()) return scale.status();
+  const double scale_seconds = Seconds(start);
+  PoseGraphSolverOptions gnc = options;
+  gnc.noise_scale = *scale;
+  // GNC's warm start is the Cauchy solve at that scale: from the last one there, not from odometry.
+  const bool had_estimate = graph.has_initial_estimate();
+  graph.poses() = robust.poses();
+  graph.set_has_initial_estimate(true);
+  gnc.init = PoseGraphSolverOptions::Init::kFile;
+  auto summary = SolvePoseGraph(graph, gnc);
+  graph.set_has_initial_estimate(had_estimate);
+  if (!summary.ok()) return summary.status();
+  summary->scale_seconds = scale_seconds;
+  summary->init_seconds += scale_seconds;
+  return summary;
+}
+
 // PCM, then the ordinary solve of the graph without the rejected closures (its chordal
 // initialization no longer pulled by them). PCM keeps false closures whose cycles all run through
 // long, uncertain odometry: they agree with every closure within its drift. At the solution of
@@ -43,13 +128,15 @@ Expected<PoseGraphSolveSummary> SolveKeptEdges(PoseGraph& graph, const PoseGraph
   const auto start = std::chrono::steady_clock::now();
   PairwiseConsistencyOptions pcm_options;
   pcm_options.confidence = options.pcm_confidence;
+  pcm_options.noise_scale = options.noise_scale;  // 0: from the cycles
   auto pcm = FindConsistentLoopClosures(graph, pcm_options);
   if (!pcm.ok()) return pcm.status();
+  const double scale = pcm->noise_scale;
   const double pcm_seconds = Seconds(start);
   std::vector<bool> keep = pcm->keep;
   PoseGraphSolverOptions inner = options;
   inner.outliers = PoseGraphSolverOptions::Outliers::kNone;
-  const double threshold = ChiSquareQuantile(kResidualConfidence, graph.planar() ? 3 : 6);
+  const double threshold = scale * ChiSquareQuantile(kResidualConfidence, graph.planar() ? 3 : 6);
   // Cauchy scale at the threshold: true closures keep nearly full weight, the rest pull little.
   PoseGraphSolverOptions screen = inner;
   screen.cauchy_c = options.cauchy_c > 0.0 ? options.cauchy_c : std::sqrt(threshold);
@@ -78,6 +165,7 @@ Expected<PoseGraphSolveSummary> SolveKeptEdges(PoseGraph& graph, const PoseGraph
   graph.poses() = kept.poses();  // same vertex order
   summary->outlier_seconds = pcm_seconds;
   summary->init_seconds += pcm_seconds;
+  summary->noise_scale = scale;
   for (size_t k = 0; k < keep.size(); ++k) {
     if (!keep[k]) summary->rejected.push_back(k);
   }
@@ -102,6 +190,9 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
   if (options.init == Options::Init::kFile && !graph.has_initial_estimate()) {
     return FailedPreconditionError("--init file: the graph has no vertex estimates");
   }
+  if (options.outliers == Options::Outliers::kGnc && options.noise_scale <= 0.0 && options.cauchy_c <= 0.0) {
+    return SolveWithEstimatedScale(graph, options);
+  }
   if (options.outliers == Options::Outliers::kPcm) return SolveKeptEdges(graph, options);
   PoseGraphSolveSummary summary;
   const auto start = std::chrono::steady_clock::now();
@@ -112,6 +203,8 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
     InitializeFromSpanningTree(graph);
   }
   if (options.init == Options::Init::kChordal && !gnc) CAIRN_RETURN_IF_ERROR(InitializeChordal(graph));
+  // GNC's threshold in the units of the actual noise, unless the caller gave it.
+  if (gnc && options.cauchy_c <= 0.0 && options.noise_scale > 0.0) summary.noise_scale = options.noise_scale;
   summary.init_seconds = Seconds(start);
   summary.initial_sesync_cost = SeSyncCost(graph);
 
@@ -139,11 +232,11 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
     ceres::LossFunction* loss = nullptr;
     if (IsLoopClosure(e)) {
       if (options.outliers == Options::Outliers::kGnc) {
-        // The first solve uses a Cauchy loss (c = 1): a warm start that outliers do not drag far,
-        // which the local solver needs before GNC's rounds (its convex start is only convex for a
-        // global solver).
-        weights.push_back(std::make_unique<ceres::LossFunctionWrapper>(new ceres::CauchyLoss(1.0),
-                                                                       ceres::TAKE_OWNERSHIP));
+        // The first solve uses a Cauchy loss (c = 1 in units of the noise scale): a warm start
+        // that outliers do not drag far, which the local solver needs before GNC's rounds (its
+        // convex start is only convex for a global solver).
+        weights.push_back(std::make_unique<ceres::LossFunctionWrapper>(
+            new ceres::CauchyLoss(std::sqrt(summary.noise_scale)), ceres::TAKE_OWNERSHIP));
         weight_of_edge[k] = static_cast<int>(weights.size()) - 1;
         loss = weights.back().get();
       } else {
@@ -187,7 +280,8 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
   if (options.outliers == Options::Outliers::kGnc) {
     // Graduated non-convexity with the truncated-least-squares surrogate (Yang et al. 2020):
     // threshold cbar^2 on the squared whitened residual, mu grows until the weights are binary.
-    const double cbar2 = options.cauchy_c > 0.0 ? options.cauchy_c * options.cauchy_c : kGncDefaultThreshold;
+    const double cbar2 =
+        options.cauchy_c > 0.0 ? options.cauchy_c * options.cauchy_c : kGncDefaultThreshold * summary.noise_scale;
     double max_r2 = 0.0;
     std::vector<double> r2(graph.edges().size(), 0.0);
     auto evaluate = [&] {

@@ -18,11 +18,17 @@ struct PoseGraphSolverOptions {
   // kPcm: pairwise-consistency rejection of loop closures, then the solve of the kept edges.
   // kGnc: graduated non-convexity (truncated least squares) from the odometry initialization.
   enum class Outliers { kNone, kPcm, kGnc };
+
   Objective objective = Objective::kGeodesic;
   Init init = Init::kChordal;
   Outliers outliers = Outliers::kNone;
+  // Factor s by which the actual noise variance exceeds the information's: the outlier thresholds
+  // (PCM's, GNC's and its warm-start Cauchy scale) are multiplied by it. 0 = estimated (see
+  // SolvePoseGraph); 1 = the information as given. An explicit cauchy_c with GNC is used as given.
+  double noise_scale = 0.0;
   // Cauchy scale c (eq. 4.10) on loop closures (edges other than i -> i+1 of one robot); 0 = none.
-  // With GNC, c^2 is the truncation threshold on the squared whitened residual (default 22.46).
+  // With GNC, c^2 is the truncation threshold on the squared whitened residual (default 22.46
+  // times the noise scale).
   double cauchy_c = 0.0;
   int64_t max_iterations = 200;
   // Chi-square probability of the pairwise-consistency test of two loop closures (kPcm).
@@ -41,6 +47,7 @@ struct PoseGraphSolverOptions {
     v.Choice("objective", objective, {{"geodesic", Objective::kGeodesic}, {"sesync", Objective::kSeSync}});
     v.Choice("init", init, {{"chordal", Init::kChordal}, {"odometry", Init::kOdometry}, {"file", Init::kFile}});
     v.Choice("outliers", outliers, {{"none", Outliers::kNone}, {"pcm", Outliers::kPcm}, {"gnc", Outliers::kGnc}});
+    v.Number("noise_scale", noise_scale, 0.0, 1e12, "variance ratio (0 = estimated)");
     v.Number("cauchy_c", cauchy_c, 0.0, 1e6, "sqrt(chi2)");
     v.Integer("max_iterations", max_iterations, 1, 100000, "iterations");
     v.Number("pcm_confidence", pcm_confidence, 0.5, 0.999999, "probability");
@@ -62,6 +69,8 @@ struct PoseGraphSolveSummary {
   int rejected_edges = 0;        // loop closures given zero weight by outlier rejection
   std::vector<size_t> rejected;  // their edge indices, ascending
   double outlier_seconds = 0.0;  // of the pairwise-consistency search (part of init_seconds)
+  double noise_scale = 1.0;      // the thresholds' factor, given or estimated
+  double scale_seconds = 0.0;    // of its estimate's Cauchy solves (part of init_seconds)
   std::string termination;
 };
 
@@ -69,6 +78,12 @@ struct PoseGraphSolveSummary {
 bool IsLoopClosure(const PoseGraphEdge& e);
 
 // With kPcm the costs in the summary are those of the kept edges.
+// Estimated noise scale (GNC with noise_scale 0 and no cauchy_c): s such that the estimate of
+// noise_scale.h from the loop closures' residuals at the Cauchy solution with c = sqrt(s) is s
+// again (to a factor of two; a few Cauchy solves), then GNC with s. Not again at GNC's own
+// solution: from odometry, GNC's rounds with a threshold at the bare inlier residuals of the
+// final solution drop true closures that intermediate solutions leave far off. With PCM, noise_scale 0 estimates the scale from the cycles
+// (pairwise_consistency.h).
 Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options);
 
 }  // namespace cairn

@@ -27,6 +27,8 @@ constexpr const char* kSolveUsage =
     "usage: cairn graph solve IN.g2o|DIR [--out OUT.g2o] [--objective geodesic|sesync]\n"
     "                         [--init chordal|odometry|file] [--loss none|cauchy:C]\n"
     "                         [--outliers none|pcm|gnc] [--pcm-confidence P (chi-square probability, 0.99)]\n"
+    "                         [--noise-scale auto|S (outlier thresholds in units of the estimated noise,\n"
+    "                          or of S times the variance the information states; auto)]\n"
     "                         [--injected-after N (edges from index N on are false: prints recall)]\n"
     "                         [--threads N] [--verbose]\n"
     "                         [--tolerance REL (relative cost change that ends the solve)]\n"
@@ -64,6 +66,9 @@ bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, 
       if (*end != '\0' || !(o.cauchy_c > 0.0)) return false;
     } else if (a == "--outliers" && (v == "none" || v == "pcm" || v == "gnc")) {
       o.outliers = v == "gnc" ? O::Outliers::kGnc : v == "pcm" ? O::Outliers::kPcm : O::Outliers::kNone;
+    } else if (a == "--noise-scale") {
+      o.noise_scale = v == "auto" ? 0.0 : std::atof(v.c_str());
+      if (!(o.noise_scale > 0.0) && v != "auto") return false;
     } else if (a == "--pcm-confidence") {
       o.pcm_confidence = std::atof(v.c_str());
       if (!(o.pcm_confidence >= 0.5 && o.pcm_confidence < 1.0)) return false;
@@ -167,11 +172,11 @@ int RunGraphSolve(const CommandArgs& args) {
       "{\"input\": \"%s\", \"ate_vs_reference\": %.6g, \"vertices\": %zu, \"edges\": %zu, \"components\": %d, "
       "\"sesync_cost\": %.10g, \"geodesic_chi2\": %.10g, \"initial_sesync_cost\": %.10g, "
       "\"iterations\": %d, \"rejected_edges\": %d, \"init_seconds\": %.4f, \"solve_seconds\": %.4f, "
-      "\"outlier_seconds\": %.4f, \"wall_seconds\": %.4f%s}\n",
+      "\"outlier_seconds\": %.4f, \"noise_scale\": %.6g, \"scale_seconds\": %.4f, \"wall_seconds\": %.4f%s}\n",
       in.c_str(), ate, graph->num_vertices(), graph->edges().size(), summary->components,
       summary->sesync_cost, summary->geodesic_chi2, summary->initial_sesync_cost, summary->iterations,
       summary->rejected_edges, summary->init_seconds, summary->solve_seconds, summary->outlier_seconds,
-      summary->init_seconds + summary->solve_seconds, outlier_stats.c_str());
+      summary->noise_scale, summary->scale_seconds, summary->init_seconds + summary->solve_seconds, outlier_stats.c_str());
   return 0;
 }
 
