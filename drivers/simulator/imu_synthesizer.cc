@@ -26,7 +26,14 @@ std::vector<ImuTruth> ImuSynthesizer::Generate(const BSplineTrajectory& trajecto
   const double rg = calibration_.gyro_random_walk * std::sqrt(dt);
   const double ra = calibration_.accel_random_walk * std::sqrt(dt);
   SimRandom rng(seed_);
-  auto normal3 = [&] { return Eigen::Vector3d(rng.Normal(), rng.Normal(), rng.Normal()); };
+  // z, y, x: one noise sequence whatever order a compiler evaluates arguments in (GCC's order, so
+  // earlier missions keep their IMU data).
+  auto normal3 = [&] {
+    const double z = rng.Normal();
+    const double y = rng.Normal();
+    const double x = rng.Normal();
+    return Eigen::Vector3d(x, y, z);
+  };
   Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero();
   if (noise_) {
     // Turn-on biases of a few times the in-run walk over a minute.

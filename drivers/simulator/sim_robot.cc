@@ -74,8 +74,12 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
   SimRandom rng = SimRandom::Stream(seed, 100 + static_cast<uint64_t>(index));
   const double limit = terrain.half_size() - 3.0;
   const double R0 = std::min(7.0, limit / 2), phase = rng.Uniform(0, 2 * kPi);
-  const Eigen::Vector2d center(std::clamp(rng.Uniform(-3, 3) + 4.0 * index, -limit + R0, limit - R0),
-                               std::clamp(rng.Uniform(-3, 3), -limit + R0, limit - R0));
+  // y before x: a seed names one world whatever order a compiler evaluates arguments in (this is
+  // the order GCC's builds always drew, so earlier missions keep their paths).
+  const double center_y = rng.Uniform(-3, 3);
+  const double center_x = rng.Uniform(-3, 3);
+  const Eigen::Vector2d center(std::clamp(center_x + 4.0 * index, -limit + R0, limit - R0),
+                               std::clamp(center_y, -limit + R0, limit - R0));
   const double speed = 0.4, wobble = 0.15;
   auto xy_at = [&](double s) {
     const double th = phase + s / R0;
