@@ -21,6 +21,10 @@ DepthFusion::DepthFusion(const DepthFusionOptions& options, const StereoCamera& 
   out_.depth.resize(n);
   out_.intensity.reserve(n);
   out_sigma_.resize(n);
+  ray_x_.resize(static_cast<size_t>(intrinsics_.width));
+  for (int u = 0; u < intrinsics_.width; ++u) {
+    ray_x_[static_cast<size_t>(u)] = static_cast<float>((u - intrinsics_.cx) / intrinsics_.fx);
+  }
 }
 
 void DepthFusion::Rebase(const Eigen::Isometry3d& T_old_new) {
@@ -40,7 +44,7 @@ bool DepthFusion::Sample(float u, float v, float* depth, float* sigma) const {
   for (int k = 0; k < 4; ++k) {
     d[k] = previous_depth_[idx[k]];
     s[k] = previous_sigma_[idx[k]];
-    all = all && std::isfinite(d[k]);
+    all = all && d[k] < kInf;  // false for NaN too
   }
   if (all) {
     // Interpolated only within one surface: across a depth edge the mean lies on neither side.
@@ -57,7 +61,7 @@ bool DepthFusion::Sample(float u, float v, float* depth, float* sigma) const {
   // position should not end a pixel's history.
   int best = -1;
   for (int k = 0; k < 4; ++k) {
-    if (std::isfinite(d[k]) && (best < 0 || wk[k] > wk[best])) best = k;
+    if (d[k] < kInf && (best < 0 || wk[k] > wk[best])) best = k;
   }
   if (best < 0) return false;
   *depth = d[best];
@@ -89,10 +93,15 @@ Status DepthFusion::Fuse(const DepthImage& image, const Eigen::Isometry3d& T_loc
   const float fx = static_cast<float>(intrinsics_.fx), fy = static_cast<float>(intrinsics_.fy);
   const float cx = static_cast<float>(intrinsics_.cx), cy = static_cast<float>(intrinsics_.cy);
   const float k2 = static_cast<float>(options_.agreement_sigmas * options_.agreement_sigmas);
-  // Prior weight at most (max_images - 1) new measurements: the variance stays >= sigma^2 / N.
-  const float max_prior = static_cast<float>(options_.max_images - 1);
-  const bool warp = has_previous_;
-  stats_ = {};
+  // The prior weighs at most (max_images - 1) new measurements: its variance is taken as at least
+  // the new one's / (max_images - 1), so the fused variance stays >= sigma^2 / max_images.
+  const float min_prior_share = options_.max_images > 1 ? 1.0f / static_cast<float>(options_.max_images - 1) : 0.0f;
+  const bool warp = has_previous_ && options_.max_images > 1;
+  const float* in = image.depth.data();
+  float* depth = out_.depth.data();
+  float* sigma_out = out_sigma_.data();
+  const float* ray_x = ray_x_.data();
+  int64_t measured = 0, fused = 0;
   for (int v = 0; v < h; ++v) {
     const size_t row = static_cast<size_t>(v) * static_cast<size_t>(w);
     const float y = (static_cast<float>(v) - cy) / fy;
@@ -100,36 +109,36 @@ Status DepthFusion::Fuse(const DepthImage& image, const Eigen::Isometry3d& T_loc
     const Eigen::Vector3f base = R.col(1) * y + R.col(2);
     for (int u = 0; u < w; ++u) {
       const size_t i = row + static_cast<size_t>(u);
-      const float z = image.depth[i];
-      out_.depth[i] = z;
-      if (!(z > 0.0f) || !std::isfinite(z)) {
-        out_sigma_[i] = kInf;
+      const float z = in[i];
+      depth[i] = z;
+      if (!(z > 0.0f && z < kInf)) {
+        sigma_out[i] = kInf;
         continue;
       }
-      ++stats_.measured;
+      ++measured;
       const float sigma = c_ * z * z;
-      out_sigma_[i] = sigma;
+      sigma_out[i] = sigma;
       if (!warp) continue;
-      const float x = (static_cast<float>(u) - cx) / fx;
-      const Eigen::Vector3f p = (base + R.col(0) * x) * z + t;  // in the previous camera
+      const Eigen::Vector3f p = (base + R.col(0) * ray_x[u]) * z + t;  // in the previous camera
       if (!(p.z() > 0.0f)) continue;
-      const float up = fx * p.x() / p.z() + cx, vp = fy * p.y() / p.z() + cy;
+      const float inv_pz = 1.0f / p.z();
       float zf = 0.0f, sf = 0.0f;
-      if (!Sample(up, vp, &zf, &sf)) continue;
+      if (!Sample(fx * p.x() * inv_pz + cx, fy * p.y() * inv_pz + cy, &zf, &sf)) continue;
       // The fused surface on the previous camera's ray through p, seen from the new camera: the
       // point (zf / p.z) p, whose new depth is r . ((zf / p.z) p - t) with r . p = z + r . t.
-      const float predicted = zf / p.z() * (z + rt) - rt;
-      const float var_new = sigma * sigma, var_prior = sf * sf;
-      const float diff = z - predicted;
-      if (diff * diff > k2 * (var_new + var_prior)) continue;
-      const float w_new = 1.0f / var_new;
-      const float w_prior = std::min(1.0f / var_prior, max_prior * w_new);
-      const float w_sum = w_new + w_prior;
-      out_.depth[i] = (w_new * z + w_prior * predicted) / w_sum;
-      out_sigma_[i] = 1.0f / std::sqrt(w_sum);
-      ++stats_.fused;
+      const float predicted = zf * inv_pz * (z + rt) - rt;
+      const float var_new = sigma * sigma, var_prior = std::max(sf * sf, var_new * min_prior_share);
+      const float diff = z - predicted, var_sum = var_new + var_prior;
+      if (diff * diff > k2 * var_sum) continue;
+      // Inverse-variance weights, in variances: one division.
+      const float inv_sum = 1.0f / var_sum;
+      depth[i] = (var_prior * z + var_new * predicted) * inv_sum;
+      sigma_out[i] = std::sqrt(var_new * var_prior * inv_sum);
+      ++fused;
     }
   }
+  stats_.measured = measured;
+  stats_.fused = fused;
   T_local_previous_ = T_local_cam;
   has_previous_ = true;
   return Status::Ok();

@@ -51,6 +51,7 @@ class DepthFusion {
   DepthFusionOptions options_;
   PinholeRadTan intrinsics_;
   float c_;  // eq. 5.2c: sigma_z = c z^2
+  std::vector<float> ray_x_;  // x / z of each column's ray
   bool has_previous_ = false;
   Eigen::Isometry3d T_local_previous_ = Eigen::Isometry3d::Identity();
   std::vector<float> previous_depth_, previous_sigma_;
