@@ -134,6 +134,7 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("images_dropped", m.images_dropped);
     j.Field("errors", m.mapping_errors);
     j.Field("points", m.mapper.points).Field("obstacle_points", m.mapper.obstacle_points);
+    j.Field("fused_pixels", m.mapper.fused_pixels).Field("unmapped_points", m.mapper.unmapped_points);
     j.Field("switch_requests", m.switch_requests);
     j.Field("frame_switches", m.frame_switches);
     j.Field("unannounced_frame_changes", m.mapper.unannounced_frame_changes);

@@ -12,8 +12,8 @@ DepthProjector::DepthProjector(const DepthPointOptions& options, const StereoCam
       model_(camera.intrinsics.fx, camera.baseline, options.pixel_error_px),
       range_(std::min(options.max_depth, model_.MaxDepthForError(options.max_depth_error))) {}
 
-Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d& T_local_body,
-                               CameraPoints* out) const {
+Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d& T_local_body, CameraPoints* out,
+                               std::span<const float> depth_error) const {
   const PinholeRadTan& k = camera_.intrinsics;
   if (image.width != k.width || image.height != k.height) {
     return InvalidArgumentError("depth image " + std::to_string(image.width) + "x" + std::to_string(image.height) +
@@ -22,6 +22,9 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
   if (image.depth.size() != static_cast<size_t>(image.width) * static_cast<size_t>(image.height) ||
       (!image.intensity.empty() && image.intensity.size() != image.depth.size())) {
     return InvalidArgumentError("depth image buffers do not match its size");
+  }
+  if (!depth_error.empty() && depth_error.size() != image.depth.size()) {
+    return InvalidArgumentError("depth errors do not match the depth image's size");
   }
   // Not Clear(): the point buffers are resized below, keeping what they hold.
   out->far_local.clear();
@@ -48,7 +51,8 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
   out->intensity.resize(pixels);
   Eigen::Vector3f* p_cam = out->p_cam.data();
   Eigen::Vector3f* p_local = out->p_local.data();
-  float* depth_error = out->depth_error.data();
+  float* point_error = out->depth_error.data();
+  const float* pixel_error = depth_error.empty() ? nullptr : depth_error.data();
   uint32_t* pixel = out->pixel.data();
   uint8_t* intensity = out->intensity.data();
   const uint8_t* gray = image.intensity.data();
@@ -66,7 +70,7 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
         const uint32_t pix = static_cast<uint32_t>(v * image.width + u);
         p_cam[n] = p;
         p_local[n] = R * p + t;
-        depth_error[n] = c * z * z;
+        point_error[n] = pixel_error != nullptr ? pixel_error[pix] : c * z * z;
         pixel[n] = pix;
         intensity[n] = has_intensity ? gray[pix] : uint8_t{0};
         ++n;

@@ -1,5 +1,6 @@
 #include "mapping/local_mapper.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -13,6 +14,36 @@ double MaxDistance(const StereoCamera& c, double range) {
   return range * std::sqrt(1.0 + ax * ax + ay * ay);
 }
 
+// Copies the points whose depth error is within `max_error` to `out`; each other point becomes
+// the end of a free-space ray its depth error short of it. False (and `out` untouched) when every
+// point is kept.
+bool KeepAccurate(const CameraPoints& in, float max_error, CameraPoints* out) {
+  const size_t n = in.size();
+  size_t first = 0;
+  while (first < n && in.depth_error[first] <= max_error) ++first;
+  if (first == n) return false;
+  out->Clear();
+  out->time = in.time;
+  out->T_local_cam = in.T_local_cam;
+  out->far_local = in.far_local;
+  const Eigen::Vector3f origin = in.T_local_cam.translation().cast<float>();
+  for (size_t i = 0; i < n; ++i) {
+    const float e = in.depth_error[i];
+    if (e > max_error) {
+      const float keep = std::max(0.0f, 1.0f - e / in.p_cam[i].z());
+      out->far_local.push_back(origin + keep * (in.p_local[i] - origin));
+      continue;
+    }
+    out->p_cam.push_back(in.p_cam[i]);
+    out->p_local.push_back(in.p_local[i]);
+    out->depth_error.push_back(e);
+    out->pixel.push_back(in.pixel[i]);
+    out->intensity.push_back(in.intensity[i]);
+    out->obstacle.push_back(in.obstacle[i]);
+  }
+  return true;
+}
+
 }  // namespace
 
 LocalMapper::LocalMapper(const MappingOptions& options, const StereoCamera& camera, std::string robot,
@@ -20,6 +51,7 @@ LocalMapper::LocalMapper(const MappingOptions& options, const StereoCamera& came
     : options_(options),
       robot_(std::move(robot)),
       projector_(options.depth, camera),
+      fusion_(options.fusion, camera, projector_.error_model()),
       classifier_(options.obstacles, camera, projector_.error_model(), projector_.range()),
       integrator_(options.submap.octree_resolution, MaxDistance(camera, projector_.range())),
       rolling_(options.rolling_map),
@@ -47,15 +79,33 @@ Status LocalMapper::Process(const DepthImage& image, const MappingPose& pose) {
     ++stats_.unannounced_frame_changes;
     finished_ = FinishAndStart(pose.frame_id);
     rolling_.Clear();
+    fusion_.Reset();
   }
-  CAIRN_RETURN_IF_ERROR(projector_.Project(image, pose.T_local_body, &points_));
-  CAIRN_RETURN_IF_ERROR(classifier_.Classify(image, &points_, &obstacles_));
+  const DepthImage* depth = &image;
+  std::span<const float> depth_error;
+  if (options_.fusion.enabled) {
+    CAIRN_RETURN_IF_ERROR(fusion_.Fuse(image, pose.T_local_body * projector_.camera().T_body_cam));
+    depth = &fusion_.fused();
+    depth_error = fusion_.depth_error();
+    stats_.fused_pixels += fusion_.stats().fused;
+  }
+  CAIRN_RETURN_IF_ERROR(projector_.Project(*depth, pose.T_local_body, &points_, depth_error));
+  // The classifier sees the fused depths but keeps eq. 5.4's single-image errors in its step
+  // thresholds, with which its recall was measured: the fused sigma assumes independent images,
+  // which stereo on the same texture from nearby poses is not entirely.
+  CAIRN_RETURN_IF_ERROR(classifier_.Classify(*depth, &points_, &obstacles_));
   const Eigen::Vector3d body = pose.T_local_body.translation();
   rolling_.Recenter(body.head<2>());
   rolling_.Integrate(obstacles_.cells);
   if (open_->metadata().images > 0) open_->AddDistance((body - last_body_).norm());
   last_body_ = body;
-  open_->Integrate(points_, &integrator_);
+  const CameraPoints* mapped = &points_;
+  if (options_.depth.max_map_error > 0.0 &&
+      KeepAccurate(points_, static_cast<float>(options_.depth.max_map_error), &mapped_)) {
+    mapped = &mapped_;
+    stats_.unmapped_points += static_cast<int64_t>(points_.size() - mapped_.size());
+  }
+  open_->Integrate(*mapped, &integrator_);
   partitioner_.Update(pose.time, pose.frame_id, body, pose.position_covariance);
   ++stats_.images;
   stats_.points += static_cast<int64_t>(points_.size());
@@ -66,6 +116,7 @@ Status LocalMapper::Process(const DepthImage& image, const MappingPose& pose) {
 std::shared_ptr<const Submap> LocalMapper::OnFrameSwitch(uint64_t new_frame_id, const Eigen::Isometry3d& T_old_new) {
   last_body_ = T_old_new.inverse() * last_body_;
   rolling_.Rebase(T_old_new, last_body_.head<2>());
+  fusion_.Rebase(T_old_new);
   auto done = FinishAndStart(new_frame_id);
   started_ = true;
   return done;

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 
+#include "mapping/depth_fusion.h"
 #include "mapping/depth_projector.h"
 #include "mapping/frame_switch_requester_interface.h"
 #include "mapping/obstacle_classifier.h"
@@ -30,6 +31,8 @@ struct MappingPose {
 struct LocalMapperStats {
   int64_t images = 0;
   int64_t points = 0;
+  int64_t fused_pixels = 0;  // pixels averaged with earlier images (mapping.fusion)
+  int64_t unmapped_points = 0;  // points beyond depth.max_map_error: free space only
   int64_t obstacle_points = 0;
   int64_t submaps_finished = 0;
   int64_t unannounced_frame_changes = 0;  // poses in a new frame without OnFrameSwitch
@@ -63,6 +66,7 @@ class LocalMapper {
   MappingOptions options_;
   std::string robot_;
   DepthProjector projector_;
+  DepthFusion fusion_;
   ObstacleClassifier classifier_;
   OccupancyIntegrator integrator_;
   RollingObstacleMap rolling_;
@@ -71,6 +75,7 @@ class LocalMapper {
   bool started_ = false;
   Eigen::Vector3d last_body_ = Eigen::Vector3d::Zero();
   CameraPoints points_;
+  CameraPoints mapped_;  // points_ without those beyond depth.max_map_error
   ObstacleResult obstacles_;
   std::shared_ptr<const Submap> finished_;
   LocalMapperStats stats_;

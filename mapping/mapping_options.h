@@ -20,6 +20,12 @@ struct DepthPointOptions {
   // suffices since a 0.1 m voxel at the range limit spans tens of pixels.
   int64_t far_ray_stride_px = 4;
   bool clear_free_beyond_range = true;
+  // m; points whose depth error (the fused one with mapping.fusion) exceeds this stay out of the
+  // submap's cloud and mark no occupied voxel: their ray only clears free space up to the depth
+  // minus that error. Such a point could lie several voxels off, and below a surface seen from
+  // above no later ray clears what it marked. The obstacle classifier still sees every point.
+  // 0: every point within max_depth_error is mapped (thesis).
+  double max_map_error = 0.0;
 
   void Visit(OptionsVisitor& v) {
     v.Number("pixel_error_px", pixel_error_px, 0.01, 10.0, "px");
@@ -28,10 +34,30 @@ struct DepthPointOptions {
     v.Number("max_depth_error", max_depth_error, 0.001, 10.0, "m");
     v.Integer("far_ray_stride_px", far_ray_stride_px, 1, 64, "px");
     v.Flag("clear_free_beyond_range", clear_free_beyond_range);
+    v.Number("max_map_error", max_map_error, 0.0, 10.0, "m");
   }
   Status Validate() const {
     if (min_depth >= max_depth) return InvalidArgumentError("min_depth must be below max_depth");
     return Status::Ok();
+  }
+};
+
+// Temporal fusion of consecutive depth images (per camera): the previous fused depth image is
+// warped into each new camera with the filter's relative pose and averaged with the new
+// measurement per pixel, weighted by their eq. 5.2c variances, where both agree.
+struct DepthFusionOptions {
+  bool enabled = false;
+  // A pixel fuses when |z_new - z_predicted| <= this many sigmas of their combined eq. 5.2c
+  // error; otherwise (occlusion, disocclusion, something moved) the new measurement restarts it.
+  double agreement_sigmas = 3.0;
+  // The fused variance stays at least the new measurement's over this many images: an average of
+  // about the last max_images images, so pose drift and changes of the scene fade out.
+  int64_t max_images = 10;
+
+  void Visit(OptionsVisitor& v) {
+    v.Flag("enabled", enabled);
+    v.Number("agreement_sigmas", agreement_sigmas, 0.5, 20.0, "");
+    v.Integer("max_images", max_images, 1, 1000, "images");
   }
 };
 
@@ -131,6 +157,7 @@ struct CompositionOptions {
 
 struct MappingOptions {
   DepthPointOptions depth;
+  DepthFusionOptions fusion;
   ObstacleOptions obstacles;
   RollingMapOptions rolling_map;
   SubmapOptions submap;
@@ -139,6 +166,7 @@ struct MappingOptions {
 
   void Visit(OptionsVisitor& v) {
     v.Section("depth", depth);
+    v.Section("fusion", fusion);
     v.Section("obstacles", obstacles);
     v.Section("rolling_map", rolling_map);
     v.Section("submap", submap);

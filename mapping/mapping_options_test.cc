@@ -9,7 +9,8 @@ namespace {
 
 constexpr const char* kYaml = R"(
 depth: {pixel_error_px: 0.5, min_depth: 0.3, max_depth: 8.0, max_depth_error: 0.2, far_ray_stride_px: 4,
-        clear_free_beyond_range: true}
+        clear_free_beyond_range: true, max_map_error: 0.1}
+fusion: {enabled: true, agreement_sigmas: 2.5, max_images: 8}
 obstacles: {edge_jump: 0.2, edge_jump_sigmas: 3.0, max_slope: 0.5, edge_max_gap_rows: 2, edge_max_range: 12.0,
             cell_size: 0.05, window_cells: 4, max_step: 0.1, error_adaptive: true, step_tie_tolerance: 0.01,
             min_cell_points: 3}
@@ -29,6 +30,9 @@ TEST(MappingOptionsTest, LoadsFromYamlAndNamesBadKeys) {
   EXPECT_DOUBLE_EQ(o.obstacles.max_step, 0.1);
   EXPECT_DOUBLE_EQ(o.obstacles.step_tie_tolerance, 0.01);
   EXPECT_EQ(o.obstacles.min_cell_points, 3);
+  EXPECT_TRUE(o.fusion.enabled);
+  EXPECT_DOUBLE_EQ(o.fusion.agreement_sigmas, 2.5);
+  EXPECT_EQ(o.fusion.max_images, 8);
 
   YAML::Node bad = YAML::Load(kYaml);
   bad["obstacles"]["window_cells"] = 9;      // outside 3..6
