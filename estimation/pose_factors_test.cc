@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimation/ordered_draws.h"
 #include "estimation/so3.h"
 
 namespace cairn {
@@ -11,8 +12,8 @@ namespace {
 
 Pose3 RandomPose(std::mt19937& rng, double scale = 1.0) {
   std::normal_distribution<double> n(0.0, 1.0);
-  return {Eigen::Vector3d(n(rng), n(rng), n(rng)) * 3.0,
-          so3::ExpQuaternion(scale * Eigen::Vector3d(n(rng), n(rng), n(rng)))};
+  const Eigen::Vector3d t = DrawVector3(n, rng) * 3.0;
+  return {t, so3::ExpQuaternion(scale * DrawVector3(n, rng))};
 }
 
 Matrix6d RandomInformation(std::mt19937& rng) {

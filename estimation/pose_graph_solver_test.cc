@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "estimation/g2o_io.h"
+#include "estimation/ordered_draws.h"
 #include "estimation/so3.h"
 
 namespace cairn {
@@ -103,7 +104,8 @@ TEST(PoseGraphSolverTest, GncRejectsFalseLoopClosuresOnASyntheticGraph) {
     g.AddEdge(e);
   };
   for (uint64_t i = 0; i + 1 < truth.size(); ++i) {
-    const Pose3 noise{Eigen::Vector3d(n(rng), n(rng), n(rng)), so3::ExpQuaternion(Eigen::Vector3d(n(rng), n(rng), n(rng)))};
+    const Eigen::Vector3d t = DrawVector3(n, rng);
+    const Pose3 noise{t, so3::ExpQuaternion(DrawVector3(n, rng))};
     add(i, i + 1, truth[i].Inverse() * truth[i + 1] * noise);
   }
   for (uint64_t i = 0; i < 50; i += 5) add(i, i + 10, truth[i].Inverse() * truth[i + 10]);

@@ -44,7 +44,8 @@ Pairs MakePairs(const RectifiedStereoCamera& cam, const Eigen::Isometry3d& T_kf_
   const Eigen::Isometry3d T_cur_kf = T_kf_cur.inverse();
   while (static_cast<int>(out.kf.size()) < n) {
     const double z = uz(rng);
-    const Eigen::Vector3d p_kf((ux(rng) - cam.cx) * z / cam.f, (uy(rng) - cam.cy) * z / cam.f, z);
+    const double v = uy(rng), u = ux(rng);  // GCC's argument order, on every compiler
+    const Eigen::Vector3d p_kf((u - cam.cx) * z / cam.f, (v - cam.cy) * z / cam.f, z);
     const Eigen::Vector3d p_cur = T_cur_kf * p_kf;
     if (p_cur.z() < 0.5) continue;
     StereoObservation a = Observe(cam, p_kf), b = Observe(cam, p_cur);
@@ -117,7 +118,8 @@ TEST(StereoPoseEstimatorTest, ReportsTooFewAndDegenerateInput) {
   Pairs pole;
   std::uniform_real_distribution<double> off(-0.002, 0.002), along(-1.0, 1.0);
   for (int i = 0; i < 40; ++i) {
-    const Eigen::Vector3d p(0.5 + off(rng), along(rng), 4.0 + off(rng));
+    const double dz = off(rng), y = along(rng), dx = off(rng);  // GCC's argument order
+    const Eigen::Vector3d p(0.5 + dx, y, 4.0 + dz);
     StereoPoint sp;
     ASSERT_TRUE(TriangulateStereo(cam, Observe(cam, p), 0.3, 0.5, &sp));
     pole.kf.push_back(sp);
@@ -147,8 +149,9 @@ TEST(StereoPoseEstimatorTest, CovarianceIsConsistent) {
   int ok = 0;
   for (int trial = 0; trial < kTrials; ++trial) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    const Eigen::Isometry3d truth = Motion(0.1 * u(rng), 0.1 * u(rng), 0.3 * u(rng), 0.05 * u(rng), 0.05 * u(rng),
-                                           0.05 * u(rng));
+    const Eigen::Vector3d w = 0.05 * DrawVector3(u, rng);
+    const Eigen::Vector3d t = Eigen::Vector3d(0.1, 0.1, 0.3).cwiseProduct(DrawVector3(u, rng));
+    const Eigen::Isometry3d truth = Motion(t.x(), t.y(), t.z(), w.x(), w.y(), w.z());
     const Pairs pairs = MakePairs(cam, truth, 80, o.pixel_sigma, o.pixel_sigma, rng);
     const PoseEstimate e = est.Estimate(pairs.kf, pairs.cur, static_cast<uint64_t>(trial));
     if (e.status != VoStatus::kOk) {

@@ -42,7 +42,10 @@ TEST(VoxelCloudTest, AddBatchEqualsAddingEachPoint) {
         p.emplace_back(x, -1.5f + 0.01f * static_cast<float>(k) + 0.2f * static_cast<float>(image), 0.1f * u(rng) - 20.0f);
       }
     }
-    for (int k = 0; k < 20000; ++k) p.emplace_back(40.0f * u(rng) - 20.0f, 40.0f * u(rng) - 20.0f, 40.0f * u(rng) - 20.0f);
+    for (int k = 0; k < 20000; ++k) {
+      const float z = 40.0f * u(rng) - 20.0f, y = 40.0f * u(rng) - 20.0f, x = 40.0f * u(rng) - 20.0f;
+      p.emplace_back(x, y, z);
+    }
     p.emplace_back(std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f);
     p.emplace_back(1e9f, 0.0f, 0.0f);
     for (size_t i = 0; i < p.size(); ++i) {

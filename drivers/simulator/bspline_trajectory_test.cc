@@ -13,8 +13,11 @@ BSplineTrajectory RandomTrajectory() {
   SimRandom rng(11);
   std::vector<Eigen::Vector3d> p, e;
   for (int i = 0; i < 12; ++i) {
-    p.emplace_back(rng.Uniform(-2, 2), rng.Uniform(-2, 2), rng.Uniform(-1, 1));
-    e.emplace_back(rng.Uniform(-3, 3), rng.Uniform(-0.5, 0.5), rng.Uniform(-0.5, 0.5));
+    // Last component first (GCC's argument order), the same data on every compiler.
+    const double pz = rng.Uniform(-1, 1), py = rng.Uniform(-2, 2), px = rng.Uniform(-2, 2);
+    p.emplace_back(px, py, pz);
+    const double ez = rng.Uniform(-0.5, 0.5), ey = rng.Uniform(-0.5, 0.5), ex = rng.Uniform(-3, 3);
+    e.emplace_back(ex, ey, ez);
   }
   return BSplineTrajectory(0.5, p, e);
 }

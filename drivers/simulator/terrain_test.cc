@@ -17,6 +17,14 @@ WorldOptions SmallWorld() {
   return w;
 }
 
+// A point of the central 16 m square at z = 0, drawn y first (GCC's argument order), the same on
+// every compiler.
+Eigen::Vector3d RandomGroundPoint(SimRandom& rng) {
+  const double y = rng.Uniform(-8, 8);
+  const double x = rng.Uniform(-8, 8);
+  return {x, y, 0.0};
+}
+
 TEST(TerrainTest, SameSeedSameTerrainOtherSeedOtherTerrain) {
   const Terrain a = Terrain::Generate(SmallWorld()), b = Terrain::Generate(SmallWorld());
   WorldOptions o = SmallWorld();
@@ -59,7 +67,7 @@ TEST(TerrainTest, RaycastFindsTheFirstSurfaceHit) {
   SimRandom rng(3);
   int hits = 0;
   for (int i = 0; i < 400; ++i) {
-    const Eigen::Vector3d o(rng.Uniform(-8, 8), rng.Uniform(-8, 8), 0.0);
+    const Eigen::Vector3d o = RandomGroundPoint(rng);
     const Eigen::Vector3d origin(o.x(), o.y(), t.Height(o.x(), o.y()) + rng.Uniform(0.3, 4.0));
     // From grazing (1 deg below the horizon) to steep.
     const double el = -rng.Uniform(0.017, 1.4), az = rng.Uniform(0, 6.283);
@@ -87,7 +95,7 @@ TEST(TerrainTest, RaycastFromAClearDistanceFindsTheSameHit) {
   SimRandom rng(5);
   int hits = 0;
   for (int i = 0; i < 400; ++i) {
-    const Eigen::Vector3d o(rng.Uniform(-8, 8), rng.Uniform(-8, 8), 0.0);
+    const Eigen::Vector3d o = RandomGroundPoint(rng);
     const Eigen::Vector3d origin(o.x(), o.y(), t.Height(o.x(), o.y()) + rng.Uniform(0.3, 4.0));
     const double el = -rng.Uniform(0.017, 1.4), az = rng.Uniform(0, 6.283);
     const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
@@ -111,7 +119,7 @@ TEST(TerrainTest, ClearDistanceBoundsEveryRayOfTheBundle) {
   double gained = 0.0;
   int bundles = 0;
   for (int i = 0; i < 300; ++i) {
-    const Eigen::Vector3d o(rng.Uniform(-8, 8), rng.Uniform(-8, 8), 0.0);
+    const Eigen::Vector3d o = RandomGroundPoint(rng);
     const Eigen::Vector3d origin(o.x(), o.y(), t.Height(o.x(), o.y()) + rng.Uniform(0.3, 4.0));
     const double el = -rng.Uniform(0.05, 1.4), az = rng.Uniform(0, 6.283);
     const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
@@ -120,7 +128,8 @@ TEST(TerrainTest, ClearDistanceBoundsEveryRayOfTheBundle) {
     ASSERT_GE(clear, 0.0);
     for (int k = 0; k < 20; ++k) {
       // A direction at chord distance <= spread from d (the unit sphere's cap around it).
-      const Eigen::Vector3d jitter = Eigen::Vector3d(rng.Uniform(-1, 1), rng.Uniform(-1, 1), rng.Uniform(-1, 1));
+      const double jz = rng.Uniform(-1, 1), jy = rng.Uniform(-1, 1), jx = rng.Uniform(-1, 1);
+      const Eigen::Vector3d jitter(jx, jy, jz);
       Eigen::Vector3d e = (d + 0.5 * spread * jitter).normalized();
       if ((e - d).norm() > spread) e = d;
       const TerrainHit hit = t.Raycast(origin, e, 40.0);
