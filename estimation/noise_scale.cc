@@ -8,12 +8,9 @@
 namespace cairn {
 
 double NormalQuantile(double probability) {
-  double lo = -40.0, hi = 40.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < probability ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  // The square of a standard normal variable is chi-square with one degree of freedom.
+  if (probability < 0.5) return -NormalQuantile(1.0 - probability);
+  return std::sqrt(ChiSquareQuantile(2.0 * probability - 1.0, 1));
 }
 
 NoiseScaleEstimate EstimateNoiseScale(const std::vector<double>& r2, int dof, double confidence) {

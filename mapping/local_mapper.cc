@@ -14,34 +14,34 @@ double MaxDistance(const StereoCamera& c, double range) {
   return range * std::sqrt(1.0 + ax * ax + ay * ay);
 }
 
-// Copies the points whose depth error is within `max_error` to `out`; each other point becomes
-// the end of a free-space ray its depth error short of it. False (and `out` untouched) when every
-// point is kept.
-bool KeepAccurate(const CameraPoints& in, float max_error, CameraPoints* out) {
-  const size_t n = in.size();
-  size_t first = 0;
-  while (first < n && in.depth_error[first] <= max_error) ++first;
-  if (first == n) return false;
-  out->Clear();
-  out->time = in.time;
-  out->T_local_cam = in.T_local_cam;
-  out->far_local = in.far_local;
-  const Eigen::Vector3f origin = in.T_local_cam.translation().cast<float>();
-  for (size_t i = 0; i < n; ++i) {
-    const float e = in.depth_error[i];
+// Drops the points whose depth error exceeds `max_error`, in place and keeping the others' order;
+// each becomes the end of a free-space ray its depth error short of it. Returns how many.
+size_t DropInaccurate(float max_error, CameraPoints* pts) {
+  const Eigen::Vector3f origin = pts->T_local_cam.translation().cast<float>();
+  size_t kept = 0;
+  for (size_t i = 0; i < pts->size(); ++i) {
+    const float e = pts->depth_error[i];
     if (e > max_error) {
-      const float keep = std::max(0.0f, 1.0f - e / in.p_cam[i].z());
-      out->far_local.push_back(origin + keep * (in.p_local[i] - origin));
+      const float reach = std::max(0.0f, 1.0f - e / pts->p_cam[i].z());
+      pts->far_local.push_back(origin + reach * (pts->p_local[i] - origin));
       continue;
     }
-    out->p_cam.push_back(in.p_cam[i]);
-    out->p_local.push_back(in.p_local[i]);
-    out->depth_error.push_back(e);
-    out->pixel.push_back(in.pixel[i]);
-    out->intensity.push_back(in.intensity[i]);
-    out->obstacle.push_back(in.obstacle[i]);
+    pts->p_cam[kept] = pts->p_cam[i];
+    pts->p_local[kept] = pts->p_local[i];
+    pts->depth_error[kept] = e;
+    pts->pixel[kept] = pts->pixel[i];
+    pts->intensity[kept] = pts->intensity[i];
+    pts->obstacle[kept] = pts->obstacle[i];
+    ++kept;
   }
-  return true;
+  const size_t dropped = pts->size() - kept;
+  pts->p_cam.resize(kept);
+  pts->p_local.resize(kept);
+  pts->depth_error.resize(kept);
+  pts->pixel.resize(kept);
+  pts->intensity.resize(kept);
+  pts->obstacle.resize(kept);
+  return dropped;
 }
 
 }  // namespace
@@ -99,16 +99,14 @@ Status LocalMapper::Process(const DepthImage& image, const MappingPose& pose) {
   rolling_.Integrate(obstacles_.cells);
   if (open_->metadata().images > 0) open_->AddDistance((body - last_body_).norm());
   last_body_ = body;
-  const CameraPoints* mapped = &points_;
-  if (options_.depth.max_map_error > 0.0 &&
-      KeepAccurate(points_, static_cast<float>(options_.depth.max_map_error), &mapped_)) {
-    mapped = &mapped_;
-    stats_.unmapped_points += static_cast<int64_t>(points_.size() - mapped_.size());
+  stats_.points += static_cast<int64_t>(points_.size());
+  if (options_.depth.max_map_error > 0.0) {
+    stats_.unmapped_points +=
+        static_cast<int64_t>(DropInaccurate(static_cast<float>(options_.depth.max_map_error), &points_));
   }
-  open_->Integrate(*mapped, &integrator_);
+  open_->Integrate(points_, &integrator_);
   partitioner_.Update(pose.time, pose.frame_id, body, pose.position_covariance);
   ++stats_.images;
-  stats_.points += static_cast<int64_t>(points_.size());
   stats_.obstacle_points += obstacles_.obstacle_points;
   return Status::Ok();
 }

@@ -54,7 +54,6 @@ class LocalMapper {
 
   const RollingObstacleMap& obstacle_map() const { return rolling_; }
   const OpenSubmap& open_submap() const { return *open_; }
-  const CameraPoints& last_points() const { return points_; }
   const ObstacleResult& last_obstacles() const { return obstacles_; }
   const LocalMapperStats& stats() const { return stats_; }
   // Finished submaps not yet taken (unannounced frame changes finish one inside Process).
@@ -75,7 +74,6 @@ class LocalMapper {
   bool started_ = false;
   Eigen::Vector3d last_body_ = Eigen::Vector3d::Zero();
   CameraPoints points_;
-  CameraPoints mapped_;  // points_ without those beyond depth.max_map_error
   ObstacleResult obstacles_;
   std::shared_ptr<const Submap> finished_;
   LocalMapperStats stats_;
