@@ -64,6 +64,10 @@ MappingStage::MappingStage(const MappingSetup& setup, std::unique_ptr<StereoBack
       matcher_(std::move(matcher)),
       mapper_(setup.mapping.map, MappingCamera(setup.camera, setup.T_body_cam), setup.robot, requester),
       composer_(setup.mapping.map.composition, setup.mapping.map.submap) {
+  if (setup_.stereo.bidirectional) {
+    bidirectional_ = std::make_unique<BidirectionalRasterMatcher>(
+        *matcher_, static_cast<int>(setup_.stereo.bidirectional_max_diff), setup_.stereo.sgm.pixel_error_px);
+  }
   if (setup_.mapping.write_submaps && !setup_.output_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(setup_.output_dir + "/submaps", ec);
@@ -93,7 +97,8 @@ void MappingStage::OnPair(const RectifiedPair& pair) {
   in.baseline_m = setup_.camera.baseline;
   const MonotonicClock clock;
   const Timestamp start = clock.Now();
-  if (Status s = matcher_->Match(in, &disparity_); !s.ok()) {
+  StereoMatcher& matcher = bidirectional_ != nullptr ? static_cast<StereoMatcher&>(*bidirectional_) : *matcher_;
+  if (Status s = matcher.Match(in, &disparity_); !s.ok()) {
     ++report_.match_failures;
     Error("dense stereo at " + std::to_string(pair.time.seconds()) + " s: " + s.ToString());
     return;
@@ -264,6 +269,7 @@ void MappingStage::PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& ori
 MappingStageReport MappingStage::report() const {
   MappingStageReport r = report_;
   r.backend = std::string(matcher_->name());
+  r.bidirectional = bidirectional_ != nullptr;
   if (matcher_->fpga_active()) r.device = setup_.stereo.backend.device;
   r.fpga_status = matcher_->fpga_status().ok() ? "" : matcher_->fpga_status().ToString();
   r.fpga_frames = matcher_->fpga_frames();

@@ -23,6 +23,7 @@
 #include "daemon/latency_histogram.h"
 #include "daemon/mapping_stage_options.h"
 #include "daemon/stereo_rectify_stage.h"
+#include "fpga/bidirectional_raster_matcher.h"
 #include "fpga/stereo_backend_switch.h"
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
@@ -46,7 +47,8 @@ struct MappingStageReport {
   std::string fpga_status;           // why the FPGA is not used ("" while it is)
   uint64_t pairs = 0;                // pairs densely matched
   uint64_t match_failures = 0;
-  uint64_t fpga_frames = 0, cpu_frames = 0, fpga_failures = 0;
+  bool bidirectional = false;        // each pair matched twice (stereo.bidirectional)
+  uint64_t fpga_frames = 0, cpu_frames = 0, fpga_failures = 0;  // passes on each backend
   uint64_t images_mapped = 0;
   uint64_t images_without_pose = 0;  // no valid filter estimate at the exposure
   uint64_t images_dropped = 0;       // waiting images pushed out by newer ones
@@ -99,6 +101,8 @@ class MappingStage {
 
   MappingSetup setup_;
   std::unique_ptr<StereoBackendSwitch> matcher_;
+  // Both passes over matcher_ when stereo.bidirectional is on; null otherwise.
+  std::unique_ptr<BidirectionalRasterMatcher> bidirectional_;
   StereoMatcherOutput disparity_;
   LocalMapper mapper_;
   MapComposer composer_;

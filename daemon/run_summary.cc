@@ -125,6 +125,8 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     if (!m.device.empty()) j.Field("device", m.device);
     j.Field("pairs", m.pairs);
     j.Field("failures", m.match_failures);
+    j.Field("bidirectional", m.bidirectional);
+    // Matcher passes: two per pair when bidirectional.
     j.Field("fpga_frames", m.fpga_frames).Field("cpu_frames", m.cpu_frames);
     j.Field("fpga_failures", m.fpga_failures);
     if (!m.fpga_status.empty()) j.Field("fpga_unused_because", m.fpga_status);

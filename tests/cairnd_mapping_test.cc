@@ -202,8 +202,8 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
 }
 
 // The FPGA path in the daemon: the board's cycle-accurate simulation (device: sim) behind the
-// unchanged host driver computes every dense pair, and the maps are the CPU kernel's, byte for byte
-// (same SGM in raster_paths mode).
+// unchanged host driver computes every dense pair, both passes of the profile's bidirectional
+// matching, and the maps are the CPU kernel's, byte for byte (same SGM in raster_paths mode).
 TEST(CairndMappingTest, SimulatedFpgaBoardMapsExactlyWhatTheCpuMaps) {
   const std::string out = testing::FreshTempDir("cairnd_mapping_fpga");
   const std::vector<std::string> common = {"--set", "stereo.sgm.num_disparities=32", "--set",
@@ -225,10 +225,11 @@ TEST(CairndMappingTest, SimulatedFpgaBoardMapsExactlyWhatTheCpuMaps) {
   EXPECT_EQ(df["backend"].string(), "fpga");
   EXPECT_EQ(df["device"].string(), "sim");
   EXPECT_GE(df["pairs"].number(), 4);
-  EXPECT_EQ(df["fpga_frames"].number(), df["pairs"].number());
+  EXPECT_TRUE(df["bidirectional"].boolean());
+  EXPECT_EQ(df["fpga_frames"].number(), 2 * df["pairs"].number());
   EXPECT_EQ(df["cpu_frames"].number(), 0);
   EXPECT_EQ(df["fpga_failures"].number(), 0);
-  EXPECT_EQ(dc["cpu_frames"].number(), dc["pairs"].number());
+  EXPECT_EQ(dc["cpu_frames"].number(), 2 * dc["pairs"].number());
   EXPECT_EQ(dc["pairs"].number(), df["pairs"].number());
   EXPECT_GT(sf["mapping"]["points"].number(), 0);
   EXPECT_EQ(sc["mapping"]["points"].number(), sf["mapping"]["points"].number());
@@ -253,7 +254,7 @@ TEST(CairndMappingTest, MissingFpgaFallsBackToTheCpuWithOneWarning) {
   EXPECT_EQ(d["backend"].string(), "sgm-simd-raster");
   EXPECT_EQ(d["fpga_failures"].number(), 1);
   EXPECT_EQ(d["fpga_frames"].number(), 0);
-  EXPECT_EQ(d["cpu_frames"].number(), d["pairs"].number());
+  EXPECT_EQ(d["cpu_frames"].number(), 2 * d["pairs"].number());  // two passes per pair
   EXPECT_GT(d["pairs"].number(), 0);
   EXPECT_NE(d["fpga_unused_because"].string().find("/nonexistent/uio9"), std::string::npos);
   size_t warnings = 0;
@@ -275,10 +276,19 @@ TEST(CairndMappingTest, MappingWithoutDenseStereoIsRefusedNamingTheKeys) {
 
   // The FPGA cannot compute the 8-path SGM: asking for the board with it is a configuration error.
   args = RoverArgs(out + "/b", 2.0, 0.25);
-  args.insert(args.end(), {"--set", "stereo.backend=fpga", "--set", "stereo.sgm.raster_paths=false"});
+  args.insert(args.end(), {"--set", "stereo.backend=fpga", "--set", "stereo.sgm.raster_paths=false", "--set",
+                           "stereo.bidirectional=false"});
   r = RunProcess(args);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("stereo.backend fpga"), std::string::npos) << r.output;
+
+  // The second, bottom-up pass corrects the raster paths only: the symmetric sets need none.
+  args = RoverArgs(out + "/c", 2.0, 0.25);
+  args.insert(args.end(), {"--set", "stereo.sgm.raster_paths=false"});
+  r = RunProcess(args);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("stereo.bidirectional corrects sgm.raster_paths"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rover.yaml"), std::string::npos) << r.output;
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "drivers/euroc_dataset.h"
 #include "fpga/disparity_evaluator.h"
 #include "fpga/fpga_stereo_matcher.h"
+#include "fpga/bidirectional_raster_matcher.h"
 #include "fpga/opencv_sgbm_matcher.h"
 #include "fpga/sgm_matcher.h"
 #include "fpga/simulated_stereo_device.h"
@@ -175,12 +176,12 @@ int RunStereo(const CommandArgs& args) {
       "[--paths 4|8|raster4] --out DISP.pfm [--png VIS.png] [--threads T] "
       "[--backend simd|scalar|fpga-sim] "
       "[--census WxH] [--fill] [--matcher sgm|opencv-3way|opencv-hh4] [--p1 P] [--p2 P] "
-      "[--uniqueness PERCENT] [--speckle-size PIXELS]\n";
+      "[--uniqueness PERCENT] [--speckle-size PIXELS] [--bidirectional]\n";
   const ArgMap a(args,
                  {"--max-disparity", "--min-disparity", "--calib", "--paths", "--out", "--png",
                   "--threads", "--backend", "--census", "--matcher", "--p1", "--p2", "--uniqueness",
                   "--speckle-size"},
-                 {"--fill"});
+                 {"--fill", "--bidirectional"});
   if (!a.error.empty() || a.positional.size() != 2 || a.Get("--out").empty() ||
       a.Get("--max-disparity").empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
@@ -230,8 +231,17 @@ int RunStereo(const CommandArgs& args) {
     std::fprintf(stderr, "cairn: --matcher must be sgm, opencv-3way or opencv-hh4\n");
     return 2;
   }
+  // stereo.bidirectional: the raster paths' second, bottom-up pass.
+  std::unique_ptr<StereoMatcher> both;
+  if (a.Has("--bidirectional")) {
+    if (which != "sgm" || !options.raster_paths) {
+      std::fprintf(stderr, "cairn: --bidirectional needs the sgm matcher with --paths raster4\n");
+      return 2;
+    }
+    both = std::make_unique<BidirectionalRasterMatcher>(*matcher, 16, options.pixel_error_px);
+  }
   StereoMatcherOutput out;
-  const Status s = matcher->Match(input, &out);
+  const Status s = (both != nullptr ? *both : *matcher).Match(input, &out);
   if (!s.ok()) return Fail(s);
   const Status w = WritePfm(a.Get("--out"), DisparityToFloat(out));
   if (!w.ok()) return Fail(w);
@@ -329,10 +339,18 @@ int RunBenchStereo(const CommandArgs& args) {
   cv::setNumThreads(static_cast<int>(options.threads));
   const int min_d = static_cast<int>(options.min_disparity);
   const int num_d = static_cast<int>(options.num_disparities);
+  std::unique_ptr<SgmMatcher> second;  // the bidirectional matcher's inner one; outlives it
   std::vector<std::unique_ptr<StereoMatcher>> matchers;
   matchers.push_back(std::move(*sgm));
   matchers.push_back(std::make_unique<OpenCvSgbmMatcher>(min_d, num_d, cv::StereoSGBM::MODE_SGBM_3WAY));
   matchers.push_back(std::make_unique<OpenCvSgbmMatcher>(min_d, num_d, cv::StereoSGBM::MODE_HH4));
+  // The FPGA mode's raster paths also run both ways (stereo.bidirectional) in the daemon profiles.
+  if (options.raster_paths) {
+    auto inner = SgmMatcher::Create(options);
+    if (!inner.ok()) return Fail(inner.status());
+    second = std::move(*inner);
+    matchers.push_back(std::make_unique<BidirectionalRasterMatcher>(*second, 16, options.pixel_error_px));
+  }
   std::vector<std::vector<double>> times(matchers.size()), cpu_times(matchers.size());
   std::vector<StereoMatcherOutput> outputs(matchers.size());
   // Interleaved rounds so that all matchers see the same machine state; one warm-up round.

@@ -129,9 +129,11 @@ int RunSummary(const CommandArgs& args) {
       if (s.has("mapping")) {
         const JsonValue& m = s["mapping"];
         const JsonValue& d = m["dense_stereo"];
-        std::printf("  mapping: %.0f pairs matched on %s (FPGA %.0f, CPU %.0f, FPGA failures %.0f), %.0f images "
-                    "mapped, %.0f submaps (%.0f KB), map of %.0f points\n",
-                    d["pairs"].number(), d["backend"].string().c_str(), d["fpga_frames"].number(),
+        const bool both_ways = d.has("bidirectional") && d["bidirectional"].boolean();
+        std::printf("  mapping: %.0f pairs matched on %s%s (passes: FPGA %.0f, CPU %.0f, FPGA failures %.0f), %.0f "
+                    "images mapped, %.0f submaps (%.0f KB), map of %.0f points\n",
+                    d["pairs"].number(), d["backend"].string().c_str(), both_ways ? " top-down and bottom-up" : "",
+                    d["fpga_frames"].number(),
                     d["cpu_frames"].number(), d["fpga_failures"].number(), m["images_mapped"].number(),
                     m["submaps"]["finished"].number(), m["submaps"]["bytes"].number() / 1024.0,
                     m["map_points"].number());
