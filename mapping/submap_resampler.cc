@@ -48,7 +48,7 @@ void SubmapResampler::Resample(const octomap::OcTree& tree, const std::vector<Cl
     const octomap::OcTreeKey k = it.getIndexKey();  // the leaf's lowest finest voxel
     const int cells = 1 << (tree_depth - static_cast<int>(it.getDepth()));
     const Eigen::Vector3i a(k[0] - kTreeMaxKey, k[1] - kTreeMaxKey, k[2] - kTreeMaxKey);
-    leaves_.push_back({a, cells, it->getLogOdds()});
+    leaves_.push_back({a, cells, it->getLogOdds(), tree.isNodeOccupied(*it)});
     lo = lo.cwiseMin(a);
     hi = hi.cwiseMax(a + Eigen::Vector3i::Constant(cells));
   }
@@ -85,7 +85,7 @@ void SubmapResampler::Resample(const octomap::OcTree& tree, const std::vector<Cl
   // VoxelKey::Floor rather than std::floor: the x86-64 baseline has no rounding instruction, and
   // the library call was the largest single cost of a full rebuild.
   constexpr float lim = static_cast<float>(VoxelKey::kOffset);
-  const auto add = [&](const Eigen::Vector3f& g, float value) {
+  const auto add = [&](const Eigen::Vector3f& g, float value, int32_t weight) {
     if (!(g.x() >= -lim && g.x() < lim && g.y() >= -lim && g.y() < lim && g.z() >= -lim && g.z() < lim)) return;
     const int32_t fx = VoxelKey::Floor(g.x()), fy = VoxelKey::Floor(g.y()), fz = VoxelKey::Floor(g.z());
     if (dense) {
@@ -94,14 +94,14 @@ void SubmapResampler::Resample(const octomap::OcTree& tree, const std::vector<Cl
         const uint32_t i = static_cast<uint32_t>((z * dims.y() + y) * dims.x() + x);
         Occ& o = dense_[i];
         if (o.n == 0) touched_.emplace_back(i, VoxelKey::Pack(fx, fy, fz));
-        o.sum += value;
-        ++o.n;
+        o.sum += static_cast<float>(weight) * value;
+        o.n += weight;
         return;
       }
     }
     Occ& o = resample_[VoxelKey::Pack(fx, fy, fz)];
-    o.sum += value;
-    ++o.n;
+    o.sum += static_cast<float>(weight) * value;
+    o.n += weight;
   };
   const Eigen::Vector3f tv = t * inv;
   const Eigen::Vector3f step_x = R.col(0), step_y = R.col(1), step_z = R.col(2);
@@ -113,17 +113,39 @@ void SubmapResampler::Resample(const octomap::OcTree& tree, const std::vector<Cl
     if (samples == 8 && si < 4) off.z() = 0.25f;
     sample[si] = R * off;
   }
+  // Where the points of each finest voxel lie (an aligned pose moves every voxel exactly).
+  centroids_.Clear();
+  if (!aligned) {
+    for (const CloudPoint& c : points) {
+      const Eigen::Vector3f s = c.p * inv;
+      const int32_t x = VoxelKey::Floor(s.x()), y = VoxelKey::Floor(s.y()), z = VoxelKey::Floor(s.z());
+      if (!VoxelKey::InRange(x) || !VoxelKey::InRange(y) || !VoxelKey::InRange(z)) continue;
+      PointSum& ps = centroids_[VoxelKey::Pack(x, y, z)];
+      ps.sum += s - Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+      ++ps.n;
+    }
+  }
   for (const Leaf& leaf : leaves_) {
     const float value = leaf.value;
     const int cells = leaf.cells;
-    const Eigen::Vector3f base = R * (leaf.min.cast<float>() + Eigen::Vector3f::Constant(0.5f)) + tv;
+    Eigen::Vector3f inside = Eigen::Vector3f::Constant(0.5f);
+    int32_t weight = 1;
+    if (cells == 1 && leaf.occupied && !centroids_.empty()) {
+      if (const PointSum* ps = centroids_.Find(VoxelKey::Pack(leaf.min.x(), leaf.min.y(), leaf.min.z()))) {
+        inside = ps->sum / static_cast<float>(ps->n);
+        // Its global voxel holds the surface: free space of a neighbour that lands there too must
+        // not average it away (occupied wins over free, as within an image).
+        weight = kSurfaceWeight;
+      }
+    }
+    const Eigen::Vector3f base = R * (leaf.min.cast<float>() + inside) + tv;
     for (int dz = 0; dz < cells; ++dz) {
       const Eigen::Vector3f pz = base + static_cast<float>(dz) * step_z;
       for (int dy = 0; dy < cells; ++dy) {
         const Eigen::Vector3f py = pz + static_cast<float>(dy) * step_y;
         for (int dx = 0; dx < cells; ++dx) {
           const Eigen::Vector3f g = py + static_cast<float>(dx) * step_x;
-          for (int si = 0; si < n_samples; ++si) add(g + sample[si], value);
+          for (int si = 0; si < n_samples; ++si) add(g + sample[si], value, weight);
         }
       }
     }
