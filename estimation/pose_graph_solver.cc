@@ -18,6 +18,13 @@ double Seconds(std::chrono::steady_clock::time_point since) {
 
 // Squared whitened residual beyond which GNC rejects a closure: chi-square, 6 dof, 99.9 %.
 constexpr double kGncDefaultThreshold = 22.46;
+// Relative cost change that ends a GNC round (the final solve converges fully).
+constexpr double kGncRoundTolerance = 1e-6;
+// Loop closures whose Cauchy weight is below kPruneWeight are left out of a Cauchy solve (their
+// pull at most 0.2 % of the largest); which closures those are is revisited every
+// kPruneIterations iterations.
+constexpr double kPruneWeight = 1e-6;
+constexpr int kPruneIterations = 5;
 // After PCM: the chi-square probability beyond which a kept closure's residual rejects it, and
 // how many screening solves at most.
 constexpr double kResidualConfidence = 0.999;
@@ -52,12 +59,16 @@ std::vector<double> LoopClosureChi2(const PoseGraph& graph) {
 // true ones (low), and F is found decreasing around its fixed point on every graph tried: the
 // fixed point is bracketed from s = 1 and F(1), then bisected in log s to a factor of two. Solves
 // of `robust_graph`, from odometry, each warm-started at the last; it is left at the last one.
+// The search runs twice: first with solves stopped at a relative cost change of
+// kCoarseTolerance (far from the fixed point, and while the false closures still carry weight,
+// every iteration is slow and only the estimate's factor of two matters), then from its result
+// with converged solves, which decide.
 Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolverOptions& options) {
   constexpr int kSolves = 10;
+  constexpr double kCoarseTolerance = 1e-3;
   PoseGraphSolverOptions robust = options;
   robust.outliers = PoseGraphSolverOptions::Outliers::kNone;
   if (options.init != PoseGraphSolverOptions::Init::kFile) robust.init = PoseGraphSolverOptions::Init::kOdometry;
-  robust.function_tolerance = std::max(options.function_tolerance, 1e-6);
   robust.verbose = false;
   const int dof = robust_graph.planar() ? 3 : 6;
   int solves = 0;
@@ -69,31 +80,41 @@ Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolver
     robust_graph.set_has_initial_estimate(true);
     ++solves;
     const double next = EstimateNoiseScale(LoopClosureChi2(robust_graph), dof, kResidualConfidence).scale;
-    if (options.verbose) std::fprintf(stderr, "noise scale: Cauchy c^2 %.4g gives %.4g\n", scale, next);
+    if (options.verbose) {
+      std::fprintf(stderr, "noise scale: Cauchy c^2 %.4g gives %.4g (tolerance %.0e: %d iterations, %.2f s)\n", scale,
+                   next, robust.function_tolerance, s->iterations, s->solve_seconds);
+    }
     return next;
   };
   // g(s) = log F(s) - log s: positive below the fixed point, negative above.
-  double a = 1.0;
-  auto fa = estimate_at(a);
-  if (!fa.ok()) return fa.status();
-  double b = *fa;
-  while (solves < kSolves) {
-    if (b > 0.5 * a && b < 2.0 * a) return std::sqrt(a * b);
-    auto fb = estimate_at(b);
-    if (!fb.ok()) return fb.status();
-    if ((*fa > a) != (*fb > b)) break;  // bracketed
-    a = b;
-    fa = fb;
-    b = *fb;
-  }
-  // Bisection of [a, b] in log s.
-  while (solves < kSolves && std::abs(std::log(b / a)) > std::log(2.0)) {
-    const double m = std::sqrt(a * b);
-    auto fm = estimate_at(m);
-    if (!fm.ok()) return fm.status();
-    ((*fm > m) == (*fa > a) ? a : b) = m;
-  }
-  return std::sqrt(a * b);
+  auto search = [&](double a) -> Expected<double> {
+    auto fa = estimate_at(a);
+    if (!fa.ok()) return fa.status();
+    double b = *fa;
+    while (solves < kSolves) {
+      if (b > 0.5 * a && b < 2.0 * a) return std::sqrt(a * b);
+      auto fb = estimate_at(b);
+      if (!fb.ok()) return fb.status();
+      if (*fb > 0.5 * b && *fb < 2.0 * b) return std::sqrt(b * *fb);
+      if ((*fa > a) != (*fb > b)) break;  // bracketed
+      a = b;
+      fa = fb;
+      b = *fb;
+    }
+    // Bisection of [a, b] in log s.
+    while (solves < kSolves && std::abs(std::log(b / a)) > std::log(2.0)) {
+      const double m = std::sqrt(a * b);
+      auto fm = estimate_at(m);
+      if (!fm.ok()) return fm.status();
+      ((*fm > m) == (*fa > a) ? a : b) = m;
+    }
+    return std::sqrt(a * b);
+  };
+  robust.function_tolerance = std::max(options.function_tolerance, kCoarseTolerance);
+  auto coarse = search(1.0);
+  if (!coarse.ok()) return coarse.status();
+  robust.function_tolerance = std::max(options.function_tolerance, 1e-6);
+  return search(*coarse);
 }
 
 // GNC with the estimated noise scale (see SolvePoseGraph in the header).
@@ -272,65 +293,122 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
   if (options.objective == Options::Objective::kSeSync) solver.trust_region_strategy_type = ceres::DOGLEG;
   solver.num_threads = static_cast<int>(options.threads);
   solver.minimizer_progress_to_stdout = options.verbose;
+
+  // Squared raw (unweighted) residual of every loop closure at the current blocks.
+  std::vector<double> r2(graph.edges().size(), 0.0);
+  double max_r2 = 0.0;
+  auto evaluate = [&] {
+    max_r2 = 0.0;
+    std::vector<double*> params;
+    std::vector<double> r;
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      if (!IsLoopClosure(graph.edges()[k])) continue;
+      const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(residuals[k]);
+      problem.GetParameterBlocksForResidualBlock(residuals[k], &params);
+      r.resize(static_cast<size_t>(f->num_residuals()));
+      f->Evaluate(params.data(), r.data(), nullptr);
+      double sum = 0.0;
+      for (double x : r) sum += x * x;
+      r2[k] = sum;
+      max_r2 = std::max(max_r2, sum);
+    }
+  };
+  // Solves see only the active loop closures (and every odometry edge): random false closures
+  // are long edges that fill the Cholesky factor in, so leaving out those that pull (next to)
+  // nothing keeps the solves as sparse as the inlier graph.
+  std::vector<bool> active(graph.edges().size(), true);
+  auto solve_active = [&](const ceres::Solver::Options& o, ceres::Solver::Summary* s) {
+    ceres::Problem::Options po;
+    po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem subset(po);
+    std::vector<double*> params;
+    for (size_t k = 0; k < residuals.size(); ++k) {
+      if (!active[k]) continue;
+      problem.GetParameterBlocksForResidualBlock(residuals[k], &params);
+      subset.AddResidualBlock(const_cast<ceres::CostFunction*>(problem.GetCostFunctionForResidualBlock(residuals[k])),
+                              const_cast<ceres::LossFunction*>(problem.GetLossFunctionForResidualBlock(residuals[k])),
+                              params);
+    }
+    for (size_t v = 0; v < n; ++v) {
+      double* b = &blocks[7 * v];
+      if (!subset.HasParameterBlock(b)) continue;
+      subset.SetManifold(b, manifold.get());
+      if (problem.IsParameterBlockConstant(b)) subset.SetParameterBlockConstant(b);
+    }
+    ceres::Solve(o, &subset, s);
+  };
+
   ceres::Solver::Summary ceres_summary;
-  ceres::Solve(solver, &problem, &ceres_summary);
-  summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  // Cauchy scale of the closures' loss in the first solve (GNC's warm start is one); 0 = none.
+  const double cauchy_c2 = gnc ? summary.noise_scale : options.cauchy_c * options.cauchy_c;
+  if (cauchy_c2 > 0.0) {
+    // The Cauchy loss weighs a closure by 1 / (1 + r2 / c^2) and its pull on the solution (the
+    // gradient) is at most 2 sqrt(weight) of the largest any closure exerts: closures below
+    // kPruneWeight are left out of the solve, in chunks of kPruneIterations iterations, after each
+    // of which every closure's residual is evaluated again (one that comes close re-enters).
+    const double prune_r2 = cauchy_c2 * (1.0 / kPruneWeight - 1.0);
+    auto prune = [&] {
+      evaluate();
+      bool changed = false;
+      for (size_t k = 0; k < residuals.size(); ++k) {
+        if (!IsLoopClosure(graph.edges()[k])) continue;
+        const bool a = r2[k] <= prune_r2;
+        changed = changed || a != active[k];
+        active[k] = a;
+      }
+      return changed;
+    };
+    prune();
+    int chunks = 0;
+    summary.iterations = 0;
+    ceres::Solver::Options chunk = solver;
+    // GNC's rounds move on from its warm start: it needs no more precision than a round.
+    if (gnc) chunk.function_tolerance = std::max(solver.function_tolerance, kGncRoundTolerance);
+    for (;;) {
+      chunk.max_num_iterations =
+          std::max(1, std::min(kPruneIterations, solver.max_num_iterations - summary.iterations));
+      solve_active(chunk, &ceres_summary);
+      // The next chunk goes on with the trust region this one ended with.
+      if (!ceres_summary.iterations.empty()) {
+        chunk.initial_trust_region_radius = ceres_summary.iterations.back().trust_region_radius;
+      }
+      summary.iterations += static_cast<int>(ceres_summary.iterations.size()) - 1;
+      if (options.verbose) std::fprintf(stderr, "%s\n", ceres_summary.FullReport().c_str());
+      const bool changed = prune();
+      const bool converged = ceres_summary.termination_type != ceres::NO_CONVERGENCE;
+      if ((converged && !changed) || summary.iterations >= solver.max_num_iterations ||
+          ++chunks >= solver.max_num_iterations) {
+        break;
+      }
+    }
+  } else {
+    ceres::Solve(solver, &problem, &ceres_summary);
+    summary.iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+    if (options.verbose) std::fprintf(stderr, "%s\n", ceres_summary.FullReport().c_str());
+  }
   summary.termination = ceres_summary.BriefReport();
-  if (options.verbose) std::fprintf(stderr, "%s\n", ceres_summary.FullReport().c_str());
   if (options.outliers == Options::Outliers::kGnc) {
     // Graduated non-convexity with the truncated-least-squares surrogate (Yang et al. 2020):
     // threshold cbar^2 on the squared whitened residual, mu grows until the weights are binary.
     const double cbar2 =
         options.cauchy_c > 0.0 ? options.cauchy_c * options.cauchy_c : kGncDefaultThreshold * summary.noise_scale;
-    double max_r2 = 0.0;
-    std::vector<double> r2(graph.edges().size(), 0.0);
-    auto evaluate = [&] {
-      for (size_t k = 0; k < residuals.size(); ++k) {
-        if (weight_of_edge[k] < 0) continue;
-        // The raw squared residual, without the weight.
-        const ceres::CostFunction* f = problem.GetCostFunctionForResidualBlock(residuals[k]);
-        std::vector<double*> params;
-        problem.GetParameterBlocksForResidualBlock(residuals[k], &params);
-        std::vector<double> r(static_cast<size_t>(f->num_residuals()));
-        f->Evaluate(params.data(), r.data(), nullptr);
-        double s = 0.0;
-        for (double x : r) s += x * x;
-        r2[k] = s;
-        max_r2 = std::max(max_r2, s);
-      }
-    };
-    // Rounds only follow the weights; the final solve converges fully.
-    // Each solve sees only the edges of non-zero weight: random false closures are long edges that
-    // fill the Cholesky factor in, so dropping them as their weight reaches zero keeps the rounds
-    // (and the final solve) as sparse as the inlier graph.
-    std::vector<double> weight(graph.edges().size(), 1.0);
-    auto solve_active = [&](const ceres::Solver::Options& o, ceres::Solver::Summary* s) {
-      ceres::Problem::Options po;
-      po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-      po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-      po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-      ceres::Problem active(po);
-      std::vector<double*> params;
-      for (size_t k = 0; k < residuals.size(); ++k) {
-        const int wk = weight_of_edge[k];
-        if (wk >= 0 && weight[k] <= 0.0) continue;
-        problem.GetParameterBlocksForResidualBlock(residuals[k], &params);
-        active.AddResidualBlock(const_cast<ceres::CostFunction*>(problem.GetCostFunctionForResidualBlock(residuals[k])),
-                                wk >= 0 ? weights[static_cast<size_t>(wk)].get() : nullptr, params);
-      }
-      for (size_t v = 0; v < n; ++v) {
-        double* b = &blocks[7 * v];
-        if (!active.HasParameterBlock(b)) continue;
-        active.SetManifold(b, manifold.get());
-        if (problem.IsParameterBlockConstant(b)) active.SetParameterBlockConstant(b);
-      }
-      ceres::Solve(o, &active, s);
-    };
+    // Rounds only follow the weights; the final solve converges fully. A closure of zero weight
+    // leaves the solves.
     ceres::Solver::Options round_solver = solver;
     round_solver.max_num_iterations = static_cast<int>(std::min(options.gnc_round_iterations, options.max_iterations));
-    round_solver.function_tolerance = std::max(solver.function_tolerance, 1e-6);
+    round_solver.function_tolerance = std::max(solver.function_tolerance, kGncRoundTolerance);
     evaluate();
+    // mu starts where the surrogate is convex for every residual (Yang et al.) or, when later,
+    // where a closure at the threshold keeps the weight the Cauchy warm start gave it,
+    // 1 / (1 + cbar2 / c^2): w(cbar2) = sqrt(mu (mu + 1)) - mu, so mu = w^2 / (1 - 2 w). From the
+    // convex start every closure weighs far less than the odometry: the first rounds drag the warm
+    // start back towards dead reckoning and keep every false closure (and the fill-in of the
+    // Cholesky factor it causes) in the solves for dozens of rounds.
+    const double warm_weight = 1.0 / (1.0 + cbar2 / summary.noise_scale);
     double mu = cbar2 / std::max(2.0 * max_r2 - cbar2, 1e-12);
+    if (warm_weight < 0.5) mu = std::max(mu, warm_weight * warm_weight / (1.0 - 2.0 * warm_weight));
     for (int round = 0; round < 100 && mu < 1e6; ++round) {
       bool binary = true;  // every weight already 0 or 1: further rounds change nothing
       for (size_t k = 0; k < residuals.size(); ++k) {
@@ -345,7 +423,7 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
           w = std::sqrt(cbar2 * mu * (mu + 1.0) / s) - mu;
           binary = false;
         }
-        weight[k] = w;
+        active[k] = w > 0.0;
         weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
             new ceres::ScaledLoss(nullptr, std::max(w, 1e-12), ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
       }
@@ -362,7 +440,7 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
       const bool rejected = r2[k] > cbar2;
       summary.rejected_edges += rejected ? 1 : 0;
       if (rejected) summary.rejected.push_back(k);
-      weight[k] = rejected ? 0.0 : 1.0;
+      active[k] = !rejected;
       weights[static_cast<size_t>(weight_of_edge[k])]->Reset(
           new ceres::ScaledLoss(nullptr, rejected ? 1e-12 : 1.0, ceres::TAKE_OWNERSHIP), ceres::TAKE_OWNERSHIP);
     }

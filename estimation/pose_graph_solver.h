@@ -82,8 +82,13 @@ bool IsLoopClosure(const PoseGraphEdge& e);
 // noise_scale.h from the loop closures' residuals at the Cauchy solution with c = sqrt(s) is s
 // again (to a factor of two; a few Cauchy solves), then GNC with s. Not again at GNC's own
 // solution: from odometry, GNC's rounds with a threshold at the bare inlier residuals of the
-// final solution drop true closures that intermediate solutions leave far off. With PCM, noise_scale 0 estimates the scale from the cycles
-// (pairwise_consistency.h).
+// final solution drop true closures that intermediate solutions leave far off. With PCM,
+// noise_scale 0 estimates the scale from the cycles (pairwise_consistency.h).
+// Solves with a Cauchy loss on the closures (cauchy_c, the noise scale's, GNC's warm start) leave
+// out the closures whose Cauchy weight is below 1e-6 (revisited every 5 iterations): random false
+// closures fill the Cholesky factor in and make every iteration slow. GNC's rounds start where a
+// closure at the threshold keeps the weight the Cauchy warm start gave it, not at the convex
+// surrogate (where every closure weighs far less than odometry).
 Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraphSolverOptions& options);
 
 }  // namespace cairn
