@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 
@@ -76,7 +77,6 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
   result.keep.assign(graph.edges().size(), true);
   const int dof = graph.planar() ? 3 : 6;
   result.noise_scale = options.noise_scale > 0.0 ? options.noise_scale : 1.0;
-  result.threshold = result.noise_scale * ChiSquareQuantile(options.confidence, dof);
 
   // Chains: walk the vertices in key order; a vertex continues its predecessor's chain when an
   // odometry edge joins them (the first one, should there be several).
@@ -134,9 +134,13 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
   }
   result.groups = static_cast<int>(groups.size());
 
-  // Squared Mahalanobis length of every pair's cycle, per group in pair order (i < j).
+  // Squared Mahalanobis length of every pair's cycle, per group in pair order (i < j), and of
+  // every closure's shortest cycle (fewest odometry edges).
   std::vector<std::vector<float>> cycle_chi2;
+  std::vector<double> shortest_chi2;
   for (const auto& [chain_pair, closures] : groups) {
+    std::vector<int> shortest_length(closures.size(), std::numeric_limits<int>::max());
+    std::vector<double> shortest(closures.size(), 0.0);
     const Chain& r = chains[static_cast<size_t>(chain_pair.first)];
     const Chain& s = chains[static_cast<size_t>(chain_pair.second)];
     const bool one_chain = chain_pair.first == chain_pair.second;
@@ -162,19 +166,24 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
         S += one_chain ? Ss : Matrix6d(A_r_s * Ss * A_r_s.transpose());
         const Eigen::LDLT<Matrix6d> ldlt(S);
         d2.push_back(static_cast<float>(e_r.dot(ldlt.solve(e_r))));
+        const int length = std::abs(ci.x - cj.x) + std::abs(ci.y - cj.y);
+        for (size_t m : {i, j}) {
+          if (length >= shortest_length[m]) continue;
+          shortest_length[m] = length;
+          shortest[m] = d2.back();
+        }
       }
     }
     result.pairs_tested += static_cast<int64_t>(d2.size());
+    if (closures.size() > 1) shortest_chi2.insert(shortest_chi2.end(), shortest.begin(), shortest.end());
   }
+  // The clique keeps a true closure only if its cycle with every other true closure passes:
+  // each pair is tested at the probability that makes all of them pass with `confidence`.
+  const double pair_confidence = std::pow(options.confidence, 1.0 / std::max<double>(1.0, result.pairs_tested));
+  result.threshold = result.noise_scale * ChiSquareQuantile(pair_confidence, dof);
   if (options.noise_scale <= 0.0) {
-    // The cycles' own scale: most pairs are of two true closures while false ones are a minority.
-    // A million pairs at most, evenly strided: quantiles to far better than the fit needs.
-    const size_t stride = static_cast<size_t>(result.pairs_tested / 1000000 + 1);
-    std::vector<double> all;
-    for (const auto& d2 : cycle_chi2) {
-      for (size_t k = 0; k < d2.size(); k += stride) all.push_back(d2[k]);
-    }
-    const NoiseScaleEstimate estimate = EstimateNoiseScale(all, dof, options.confidence);
+    // The scale of the closures' shortest cycles (see the header): most closures are true.
+    const NoiseScaleEstimate estimate = EstimateNoiseScale(shortest_chi2, dof, pair_confidence);
     result.noise_scale = estimate.scale;
     result.threshold = estimate.threshold;
   }

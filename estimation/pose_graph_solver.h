@@ -31,7 +31,7 @@ struct PoseGraphSolverOptions {
   // times the noise scale).
   double cauchy_c = 0.0;
   int64_t max_iterations = 200;
-  // Chi-square probability of the pairwise-consistency test of two loop closures (kPcm).
+  // Probability that every pair of true loop closures passes the pairwise-consistency test (kPcm).
   double pcm_confidence = 0.99;
   // Levenberg-Marquardt iterations per GNC round: each round only tracks the changed weights.
   int64_t gnc_round_iterations = 10;

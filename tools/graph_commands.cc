@@ -26,7 +26,7 @@ namespace {
 constexpr const char* kSolveUsage =
     "usage: cairn graph solve IN.g2o|DIR [--out OUT.g2o] [--objective geodesic|sesync]\n"
     "                         [--init chordal|odometry|file] [--loss none|cauchy:C]\n"
-    "                         [--outliers none|pcm|gnc] [--pcm-confidence P (chi-square probability, 0.99)]\n"
+    "                         [--outliers none|pcm|gnc] [--pcm-confidence P (probability that all true pairs pass, 0.99)]\n"
     "                         [--noise-scale auto|S (outlier thresholds in units of the estimated noise,\n"
     "                          or of S times the variance the information states; auto)]\n"
     "                         [--injected-after N (edges from index N on are false: prints recall)]\n"
