@@ -57,7 +57,8 @@ std::vector<double> LoopClosureChi2(const PoseGraph& graph) {
 // residual of s, 1 in the units of the noise): a loss too wide lets false closures drag true ones
 // off (F(s) high), one too narrow leaves true closures unsatisfied (also high) or nearly fits the
 // true ones (low), and F is found decreasing around its fixed point on every graph tried: the
-// fixed point is bracketed from s = 1 and F(1), then bisected in log s to a factor of two. Solves
+// fixed point is bracketed from s = 1 and F(1), then bisected in log s to a factor of two (or
+// until a scale's estimate is within a factor of two of it). Solves
 // of `robust_graph`, from odometry, each warm-started at the last; it is left at the last one.
 // The search runs twice: first with solves stopped at a relative cost change of
 // kCoarseTolerance (far from the fixed point, and while the false closures still carry weight,
@@ -106,6 +107,7 @@ Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolver
       const double m = std::sqrt(a * b);
       auto fm = estimate_at(m);
       if (!fm.ok()) return fm.status();
+      if (*fm > 0.5 * m && *fm < 2.0 * m) return std::sqrt(m * *fm);
       ((*fm > m) == (*fa > a) ? a : b) = m;
     }
     return std::sqrt(a * b);
