@@ -83,7 +83,9 @@ bool IsLoopClosure(const PoseGraphEdge& e);
 // again (to a factor of two; a few Cauchy solves), then GNC with s. Not again at GNC's own
 // solution: from odometry, GNC's rounds with a threshold at the bare inlier residuals of the
 // final solution drop true closures that intermediate solutions leave far off. With PCM,
-// noise_scale 0 estimates the scale from the cycles (pairwise_consistency.h).
+// noise_scale 0 estimates the cycles' scale from the cycles (pairwise_consistency.h) and the
+// scale of the residual screen that follows it (see SolveKeptEdges) from the kept closures'
+// residuals, as for GNC.
 // Solves with a Cauchy loss on the closures (cauchy_c, the noise scale's, GNC's warm start) leave
 // out the closures whose Cauchy weight is below 1e-6 (revisited every 5 iterations): random false
 // closures fill the Cholesky factor in and make every iteration slow. GNC's rounds start where a
