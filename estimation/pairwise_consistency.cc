@@ -177,9 +177,12 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
     result.pairs_tested += static_cast<int64_t>(d2.size());
     if (closures.size() > 1) shortest_chi2.insert(shortest_chi2.end(), shortest.begin(), shortest.end());
   }
-  // The clique keeps a true closure only if its cycle with every other true closure passes:
-  // each pair is tested at the probability that makes all of them pass with `confidence`.
-  const double pair_confidence = std::pow(options.confidence, 1.0 / std::max<double>(1.0, result.pairs_tested));
+  // The clique keeps a true closure only if its cycle with every other true closure of its group
+  // passes: each pair is tested at the probability that makes all of a closure's pass with
+  // `confidence` (in the largest group).
+  size_t largest = 0;
+  for (const auto& [chain_pair, closures] : groups) largest = std::max(largest, closures.size());
+  const double pair_confidence = std::pow(options.confidence, 1.0 / std::max(1.0, largest - 1.0));
   result.threshold = result.noise_scale * ChiSquareQuantile(pair_confidence, dof);
   if (options.noise_scale <= 0.0) {
     // The scale of the closures' shortest cycles (see the header): most closures are true.

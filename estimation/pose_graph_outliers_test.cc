@@ -388,6 +388,7 @@ TEST(PairwiseConsistencyTest, ArgosSetsUnderPcm) {
 TEST(PairwiseConsistencyTest, PcmKeepsEveryTrueClosureAmongManyPairs) {
   // 60 true closures with noise as stated (1770 pairs of them), 12 false ones: at a per-pair
   // 99 % some twenty pairs of true closures would fail and take true closures out of the clique.
+  // Each closure's 59 pairs are tested at 99 % jointly.
   PoseGraph clean;
   Scene s = NoisyClosureScene(&clean);
   PairwiseConsistencyOptions o;
