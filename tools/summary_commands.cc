@@ -7,15 +7,10 @@
 #include <string>
 
 #include <filesystem>
-#include <iostream>
 #include <optional>
 
-#include <octomap/OcTree.h>
-
-#include "daemon/cairnd_config.h"
 #include "daemon/json_value.h"
-#include "daemon/simulated_robot.h"
-#include "drivers/simulator/surface_distance.h"
+#include "daemon/simulated_map_accuracy.h"
 #include "estimation/trajectory.h"
 #include "estimation/trajectory_evaluator.h"
 #include "tools/commands.h"
@@ -56,48 +51,19 @@ std::optional<Eigen::Isometry3d> PrintAccuracy(const std::string& dir) {
   return r->T_gt_est;
 }
 
-// The map's occupied voxels against the simulated world's true surfaces (terrain, lander, and the
-// robots wherever they were), in the world through the trajectory's alignment: the map's frame is
-// trajectory.tum's (mapping_stage.cc). Issue 10 asks for >= 95 % within one voxel.
+// The map's occupied voxels against the simulated world's true surfaces, in the world through the
+// trajectory's alignment: the map's frame is trajectory.tum's (mapping_stage.cc).
 void PrintMapAccuracy(const std::string& dir, const Eigen::Isometry3d& T_world_map) {
-  const std::string map_path = dir + "/map.bt", config_path = dir + "/config.yaml";
-  if (!std::filesystem::exists(map_path) || !std::filesystem::exists(config_path)) return;
-  auto options = LoadCairndOptions(config_path, {});
-  if (!options.ok()) {
-    std::printf("  map vs world: %s\n", options.status().ToString().c_str());
-    return;
-  }
-  auto mission = OpenSimulatedMission(*options, config_path);
-  if (!mission.ok()) {
-    std::printf("  map vs world: %s\n", mission.status().ToString().c_str());
-    return;
-  }
-  octomap::OcTree tree(0.1);
-  // The library announces every file it reads on std::cerr; a failure is reported below instead.
-  std::streambuf* const cerr_buffer = std::cerr.rdbuf(nullptr);
-  const bool read = tree.readBinary(map_path);
-  std::cerr.rdbuf(cerr_buffer);
-  if (!read) {
-    std::printf("  map vs world: %s is not an OctoMap binary tree\n", map_path.c_str());
-    return;
-  }
-  // Robots move 0.3-2 m/s; every 0.1 s places their bodies within a voxel or two of any instant.
-  const sim::SurfaceDistance truth(**mission, 0.1);
-  const double voxel = tree.getResolution();
-  int64_t occupied = 0, near = 0;
-  for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
-    if (!tree.isNodeOccupied(*it)) continue;
-    const octomap::point3d c = it.getCoordinate();
-    ++occupied;
-    near += truth.Distance(T_world_map * Eigen::Vector3d(c.x(), c.y(), c.z()), voxel) <= voxel;
-  }
-  if (occupied == 0) {
+  if (!std::filesystem::exists(dir + "/map.bt")) return;
+  const auto a = ScoreSimulatedMap(dir, T_world_map);
+  if (!a.ok()) {
+    std::printf("  map vs world: %s\n", a.status().ToString().c_str());
+  } else if (a->occupied == 0) {
     std::printf("  map vs world: no occupied voxels\n");
-    return;
+  } else {
+    std::printf("  map vs world: %lld occupied voxels, %.1f %% within one voxel (%.2f m) of a true surface\n",
+                static_cast<long long>(a->occupied), 100.0 * a->fraction(), a->voxel);
   }
-  std::printf("  map vs world: %lld occupied voxels, %.1f %% within one voxel (%.2f m) of a true surface\n",
-              static_cast<long long>(occupied), 100.0 * static_cast<double>(near) / static_cast<double>(occupied),
-              voxel);
 }
 
 }  // namespace
