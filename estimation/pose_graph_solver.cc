@@ -88,15 +88,16 @@ Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolver
     return next;
   };
   // g(s) = log F(s) - log s: positive below the fixed point, negative above.
+  const auto near_fixed_point = [](double s, double f) { return f > 0.5 * s && f < 2.0 * s; };
   auto search = [&](double a) -> Expected<double> {
     auto fa = estimate_at(a);
     if (!fa.ok()) return fa.status();
     double b = *fa;
     while (solves < kSolves) {
-      if (b > 0.5 * a && b < 2.0 * a) return std::sqrt(a * b);
+      if (near_fixed_point(a, b)) return std::sqrt(a * b);
       auto fb = estimate_at(b);
       if (!fb.ok()) return fb.status();
-      if (*fb > 0.5 * b && *fb < 2.0 * b) return std::sqrt(b * *fb);
+      if (near_fixed_point(b, *fb)) return std::sqrt(b * *fb);
       if ((*fa > a) != (*fb > b)) break;  // bracketed
       a = b;
       fa = fb;
@@ -107,7 +108,7 @@ Expected<double> RobustNoiseScale(PoseGraph& robust_graph, const PoseGraphSolver
       const double m = std::sqrt(a * b);
       auto fm = estimate_at(m);
       if (!fm.ok()) return fm.status();
-      if (*fm > 0.5 * m && *fm < 2.0 * m) return std::sqrt(m * *fm);
+      if (near_fixed_point(m, *fm)) return std::sqrt(m * *fm);
       ((*fm > m) == (*fa > a) ? a : b) = m;
     }
     return std::sqrt(a * b);

@@ -59,6 +59,24 @@ struct CameraPoints {
   std::vector<Eigen::Vector3f> far_local;
 
   size_t size() const { return p_cam.size(); }
+  // The first n points (every per-point array; `obstacle` too once it is filled).
+  void Truncate(size_t n) {
+    p_cam.resize(n);
+    p_local.resize(n);
+    depth_error.resize(n);
+    pixel.resize(n);
+    intensity.resize(n);
+    if (!obstacle.empty()) obstacle.resize(n);
+  }
+  // Point `from` into slot `to` (compaction in place).
+  void MovePoint(size_t from, size_t to) {
+    p_cam[to] = p_cam[from];
+    p_local[to] = p_local[from];
+    depth_error[to] = depth_error[from];
+    pixel[to] = pixel[from];
+    intensity[to] = intensity[from];
+    if (!obstacle.empty()) obstacle[to] = obstacle[from];
+  }
   void Clear() {
     p_cam.clear();
     p_local.clear();

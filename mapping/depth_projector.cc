@@ -81,12 +81,8 @@ Status DepthProjector::Project(const DepthImage& image, const Eigen::Isometry3d&
       }
     }
   }
-  out->p_cam.resize(n);
-  out->p_local.resize(n);
-  out->depth_error.resize(n);
-  out->pixel.resize(n);
-  out->intensity.resize(n);
-  out->obstacle.assign(out->p_cam.size(), 0);
+  out->Truncate(n);
+  out->obstacle.assign(n, 0);
   return Status::Ok();
 }
 

@@ -26,21 +26,10 @@ size_t DropInaccurate(float max_error, CameraPoints* pts) {
       pts->far_local.push_back(origin + reach * (pts->p_local[i] - origin));
       continue;
     }
-    pts->p_cam[kept] = pts->p_cam[i];
-    pts->p_local[kept] = pts->p_local[i];
-    pts->depth_error[kept] = e;
-    pts->pixel[kept] = pts->pixel[i];
-    pts->intensity[kept] = pts->intensity[i];
-    pts->obstacle[kept] = pts->obstacle[i];
-    ++kept;
+    pts->MovePoint(i, kept++);
   }
   const size_t dropped = pts->size() - kept;
-  pts->p_cam.resize(kept);
-  pts->p_local.resize(kept);
-  pts->depth_error.resize(kept);
-  pts->pixel.resize(kept);
-  pts->intensity.resize(kept);
-  pts->obstacle.resize(kept);
+  pts->Truncate(kept);
   return dropped;
 }
 

@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 
+#include "mapping/occupancy_integrator.h"
+
 namespace cairn {
 
 MapComposer::MapComposer(const CompositionOptions& options, const SubmapOptions& submap)
@@ -75,29 +77,20 @@ void MapComposer::Apply(const Entry& e, int sign) {
   }
 }
 
-void MapComposer::ResampleAndApply(const std::vector<Entry*>& entries) {
-  for (Entry* e : entries) {
-    resampler_.Resample(e->submap->tree(), e->submap->points(), e->pose_target, &e->cloud, &e->occupancy);
-    e->pose_applied = e->pose_target;
-    e->applied = true;
-    Apply(*e, +1);
-  }
-}
-
 CompositionStats MapComposer::Update() {
   CompositionStats stats;
-  std::vector<Entry*> stale;
   for (auto& [ref, e] : entries_) {
     if (e.applied && !Moved(e.pose_applied, e.pose_target)) {
       ++stats.cached;
       continue;
     }
     if (e.applied) Apply(e, -1);
-    e.applied = false;
-    stale.push_back(&e);
+    resampler_.Resample(e.submap->tree(), e.submap->points(), e.pose_target, &e.cloud, &e.occupancy);
+    e.pose_applied = e.pose_target;
+    e.applied = true;
+    Apply(e, +1);
+    ++stats.rebuilt;
   }
-  ResampleAndApply(stale);
-  stats.rebuilt = static_cast<int>(stale.size());
   open_cloud_.Clear();
   open_occupancy_.Clear();
   if (open_ != nullptr) {
@@ -137,10 +130,9 @@ std::unique_ptr<octomap::OcTree> MapComposer::Octree() const {
   auto tree = MakeOccupancyTree(submap_options_);
   const auto put = [&](uint64_t key, float value) {
     const Eigen::Vector3i c = VoxelKey::Unpack(key);
-    if ((c.array().abs() >= SubmapResampler::kTreeMaxKey).any()) return;  // beyond OctoMap's key range
-    constexpr int kMax = SubmapResampler::kTreeMaxKey;
-    const octomap::OcTreeKey k(static_cast<uint16_t>(c.x() + kMax), static_cast<uint16_t>(c.y() + kMax),
-                               static_cast<uint16_t>(c.z() + kMax));
+    if ((c.array().abs() >= kOctreeKeyOrigin).any()) return;  // beyond OctoMap's key range
+    const octomap::OcTreeKey k(static_cast<uint16_t>(c.x() + kOctreeKeyOrigin), static_cast<uint16_t>(c.y() + kOctreeKeyOrigin),
+                               static_cast<uint16_t>(c.z() + kOctreeKeyOrigin));
     tree->setNodeValue(k, Clamp(value), true);
   };
   occupancy_.ForEach([&](uint64_t key, const Occ& o) {

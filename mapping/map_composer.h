@@ -81,8 +81,6 @@ class MapComposer {
     std::vector<std::pair<uint64_t, float>> occupancy;  // global voxel, resampled log-odds
   };
   bool Moved(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
-  // Resamples the entries at their target poses and adds their contributions.
-  void ResampleAndApply(const std::vector<Entry*>& entries);
   void Apply(const Entry& e, int sign);
   float Clamp(float v) const;
 

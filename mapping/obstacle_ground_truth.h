@@ -130,8 +130,8 @@ inline ObstacleScore ScoreObstacles(const sim::Terrain& terrain, const ObstacleR
     const double jump_noise = options.edge_jump_sigmas * model.DepthError(depth);
     const bool step_obstacle = step > options.max_step + band;
     const bool step_clear = step < options.max_step - band;
-    const bool edge_obstacle =
-        slope > options.max_slope && hidden > options.edge_jump + jump_noise && visible_slope > options.max_slope;
+    const bool steep_hidden = slope > options.max_slope && hidden > options.edge_jump + jump_noise;
+    const bool edge_obstacle = steep_hidden && visible_slope > options.max_slope;
     const bool edge_clear = slope <= options.max_slope || hidden <= options.edge_jump;
     bool truth;
     if (step_obstacle || edge_obstacle) {
@@ -140,7 +140,7 @@ inline ObstacleScore ScoreObstacles(const sim::Terrain& terrain, const ObstacleR
       truth = false;
     } else {
       ++s.unscored;
-      s.unscored_hidden += slope > options.max_slope && hidden > options.edge_jump + jump_noise && !step_obstacle;
+      s.unscored_hidden += steep_hidden && !step_obstacle;
       continue;
     }
     s.tp += c.obstacle && truth;

@@ -7,8 +7,6 @@ namespace cairn {
 namespace {
 uint64_t PackOctoKey(const octomap::OcTreeKey& k) { return VoxelKey::Pack(k[0], k[1], k[2]); }
 
-// The key of the cell at the origin of an OcTree of depth 16 (OcTreeBaseImpl::tree_max_val).
-constexpr int kTreeMaxVal = 1 << 15;
 
 // OcTree::updateNode(key, occupied, lazy) for every key, with the same result (including its
 // early abort on saturated nodes), but without its two descents from the root per key: the keys
@@ -137,8 +135,8 @@ void OccupancyIntegrator::MarkPoint(const Eigen::Vector3f& p) {
   bool inside = true;
   for (int a = 0; a < 3; ++a) {
     const double s = factor_ * static_cast<double>(p[a]);
-    inside = inside && s >= -kTreeMaxVal && s < kTreeMaxVal;
-    k[a] = (inside ? VoxelKey::Floor(s) : 0) + kTreeMaxVal;
+    inside = inside && s >= -kOctreeKeyOrigin && s < kOctreeKeyOrigin;
+    k[a] = (inside ? VoxelKey::Floor(s) : 0) + kOctreeKeyOrigin;
   }
   if (inside) MarkOccupied(k[0], k[1], k[2]);
 }
@@ -160,8 +158,8 @@ OccupancyUpdateStats OccupancyIntegrator::IntegrateCells(const CameraPoints& pts
   if (!Begin(pts, tree)) return {};
   for (const uint64_t cell : cells.interior) {
     const Eigen::Vector3i c = VoxelKey::Unpack(cell);
-    const int kx = (c.x() >> 1) + kTreeMaxVal, ky = (c.y() >> 1) + kTreeMaxVal, kz = (c.z() >> 1) + kTreeMaxVal;
-    constexpr int kKeys = 2 * kTreeMaxVal;
+    const int kx = (c.x() >> 1) + kOctreeKeyOrigin, ky = (c.y() >> 1) + kOctreeKeyOrigin, kz = (c.z() >> 1) + kOctreeKeyOrigin;
+    constexpr int kKeys = 2 * kOctreeKeyOrigin;
     if (kx >= 0 && ky >= 0 && kz >= 0 && kx < kKeys && ky < kKeys && kz < kKeys) MarkOccupied(kx, ky, kz);
   }
   for (const uint32_t i : cells.on_face) MarkPoint(pts.p_local[i]);

@@ -20,6 +20,10 @@
 
 namespace cairn {
 
+// OctoMap's key of coordinate 0 at its depth of 16 (OcTreeBaseImpl::tree_max_val): key = floor(x /
+// resolution) + kOctreeKeyOrigin, valid in [0, 2 kOctreeKeyOrigin).
+inline constexpr int kOctreeKeyOrigin = 1 << 15;
+
 // A tree configured with the submap options' resolution, log-odds and clamping.
 std::unique_ptr<octomap::OcTree> MakeOccupancyTree(const SubmapOptions& options);
 

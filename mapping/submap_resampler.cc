@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "mapping/occupancy_integrator.h"
+
 namespace cairn {
 namespace {
 
@@ -47,7 +49,7 @@ void SubmapResampler::Resample(const octomap::OcTree& tree, const std::vector<Cl
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     const octomap::OcTreeKey k = it.getIndexKey();  // the leaf's lowest finest voxel
     const int cells = 1 << (tree_depth - static_cast<int>(it.getDepth()));
-    const Eigen::Vector3i a(k[0] - kTreeMaxKey, k[1] - kTreeMaxKey, k[2] - kTreeMaxKey);
+    const Eigen::Vector3i a(k[0] - kOctreeKeyOrigin, k[1] - kOctreeKeyOrigin, k[2] - kOctreeKeyOrigin);
     leaves_.push_back({a, cells, it->getLogOdds(), tree.isNodeOccupied(*it)});
     lo = lo.cwiseMin(a);
     hi = hi.cwiseMax(a + Eigen::Vector3i::Constant(cells));

@@ -17,8 +17,6 @@ namespace cairn {
 
 class SubmapResampler {
  public:
-  static constexpr int kTreeMaxKey = 32768;  // OctoMap's key of coordinate 0 at depth 16
-
   // `cloud`: the points moved by T_global_submap. `occupancy`: every global voxel the tree's
   // leaves cover (VoxelKey at the tree's resolution) with the mean log-odds of what lands in it.
   // An occupied finest voxel with cloud points in it is moved from the centroid of those points,
