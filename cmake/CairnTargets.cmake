@@ -47,7 +47,7 @@ function(cairn_use_pch target pch)
 endfunction()
 
 # cairn_library(NAME SOURCES ... DEPS ...): a library rooted at the source tree so that includes
-# read "hal/timestamp.h".
+# read "common/timestamp.h".
 function(cairn_library name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(${name} ${ARG_SOURCES})

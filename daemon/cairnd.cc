@@ -7,17 +7,17 @@
 
 #include <spdlog/spdlog.h>
 
-#include "daemon/atomic_file.h"
-#include "daemon/options_yaml_writer.h"
-#include "daemon/pipeline.h"
+#include "common/atomic_file.h"
+#include "common/options_yaml_writer.h"
+#include "daemon/pipeline/pipeline.h"
 #include "daemon/run_summary.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "drivers/can_wheel_decoder.h"
-#include "drivers/euroc_replay.h"
-#include "drivers/mcap_replay.h"
+#include "drivers/replay/euroc_replay.h"
+#include "drivers/replay/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
-#include "estimation/g2o_io.h"
+#include "estimation/graph/g2o_io.h"
 
 namespace cairn {
 namespace {

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "daemon/cairnd_options.h"
-#include "drivers/euroc_dataset.h"
-#include "estimation/trajectory.h"
+#include "drivers/replay/euroc_dataset.h"
+#include "estimation/eval/trajectory.h"
 #include "hal/calibration.h"
 #include "hal/sensor_source_interface.h"
 

@@ -1,6 +1,6 @@
 #include "daemon/cairnd_config.h"
 
-#include "daemon/yaml_options_reader.h"
+#include "common/yaml_options_reader.h"
 
 namespace cairn {
 

@@ -3,8 +3,8 @@
 #include <string>
 #include <vector>
 
+#include "common/status.h"
 #include "daemon/cairnd_options.h"
-#include "hal/status.h"
 
 namespace cairn {
 

@@ -7,18 +7,18 @@
 #include <string>
 #include <vector>
 
-#include "daemon/dense_stereo_options.h"
-#include "daemon/executor_options.h"
-#include "daemon/graph_stage_options.h"
-#include "daemon/live_stream_options.h"
-#include "daemon/mapping_stage_options.h"
-#include "daemon/recording_options.h"
-#include "daemon/sim_source_options.h"
+#include "common/options_visitor.h"
+#include "daemon/pipeline/dense_stereo_options.h"
+#include "daemon/pipeline/executor_options.h"
+#include "daemon/pipeline/graph_stage_options.h"
+#include "daemon/pipeline/mapping_stage_options.h"
+#include "daemon/telemetry/live_stream_options.h"
+#include "daemon/telemetry/recording_options.h"
 #include "drivers/can_wheel_options.h"
-#include "drivers/replay_options.h"
-#include "estimation/filter_options.h"
-#include "estimation/vo_options.h"
-#include "hal/options_visitor.h"
+#include "drivers/replay/replay_options.h"
+#include "estimation/filter/filter_options.h"
+#include "estimation/vo/vo_options.h"
+#include "sim/sim_source_options.h"
 
 namespace cairn {
 

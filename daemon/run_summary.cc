@@ -1,6 +1,6 @@
 #include "daemon/run_summary.h"
 
-#include "daemon/json_writer.h"
+#include "common/json_writer.h"
 
 #include <filesystem>
 

@@ -6,8 +6,8 @@
 #include <optional>
 #include <string>
 
-#include "daemon/pipeline.h"
-#include "daemon/telemetry_stage.h"
+#include "daemon/pipeline/pipeline.h"
+#include "daemon/pipeline/telemetry_stage.h"
 
 namespace cairn {
 

@@ -7,7 +7,7 @@
 
 #include "daemon/cairnd_config.h"
 #include "daemon/simulated_robot.h"
-#include "drivers/simulator/surface_distance.h"
+#include "sim/surface_distance.h"
 
 namespace cairn {
 

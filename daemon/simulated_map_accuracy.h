@@ -1,7 +1,7 @@
 #pragma once
 // How well a simulated run's voxel map (map.bt in its output folder) lies on the simulated world's
 // true surfaces: the terrain, the lander and its markers, and every robot wherever it was (sampled
-// every 0.1 s). Issue 10's measure: the share of occupied voxels whose centre is within one voxel
+// every 0.1 s). The measure: the share of occupied voxels whose centre is within one voxel
 // of a true surface. `cairn summary` prints it; tests assert it.
 
 #include <cstdint>
@@ -9,7 +9,7 @@
 
 #include <Eigen/Geometry>
 
-#include "hal/status.h"
+#include "common/status.h"
 
 namespace cairn {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <sstream>
 
-#include "drivers/simulator/simulator_source.h"
-#include "drivers/simulator/world_file.h"
+#include "sim/simulator_source.h"
+#include "sim/world_file.h"
 
 namespace cairn {
 namespace {

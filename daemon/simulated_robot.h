@@ -6,10 +6,10 @@
 #include <string>
 
 #include "daemon/cairnd_options.h"
-#include "drivers/simulator/mission_simulator.h"
-#include "estimation/trajectory.h"
+#include "estimation/eval/trajectory.h"
 #include "hal/calibration.h"
 #include "hal/sensor_source_interface.h"
+#include "sim/mission_simulator.h"
 
 namespace cairn {
 

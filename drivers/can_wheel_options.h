@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "hal/options_visitor.h"
+#include "common/options_visitor.h"
 
 namespace cairn {
 

@@ -6,9 +6,9 @@
 #include <atomic>
 #include <thread>
 
+#include "common/clock_interface.h"
+#include "common/monotonic_clock.h"
 #include "drivers/can_wheel_decoder.h"
-#include "hal/clock_interface.h"
-#include "hal/monotonic_clock.h"
 #include "hal/wheel_odometry_interface.h"
 
 namespace cairn {

@@ -10,10 +10,10 @@
 #include <opencv2/core.hpp>
 
 #include "fpga/fpga_stereo_matcher.h"
-#include "fpga/sgm_matcher.h"
 #include "fpga/simulated_stereo_device.h"
-#include "fpga/stereo_image_io.h"
-#include "fpga/stereo_test_pair.h"
+#include "stereo/sgm_matcher.h"
+#include "stereo/stereo_image_io.h"
+#include "stereo/testing/stereo_test_pair.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "fpga/sgm_registers.h"
-#include "fpga/stereo_depth.h"
+#include "stereo/stereo_depth.h"
 
 namespace cairn {
 namespace {

@@ -16,10 +16,10 @@
 #include <string_view>
 #include <vector>
 
-#include "fpga/disparity_filter.h"
-#include "fpga/sgm_options.h"
 #include "fpga/stereo_device.h"
-#include "fpga/stereo_matcher_interface.h"
+#include "stereo/disparity_filter.h"
+#include "stereo/sgm_options.h"
+#include "stereo/stereo_matcher_interface.h"
 
 namespace cairn {
 

@@ -9,11 +9,11 @@
 #include <gtest/gtest.h>
 
 #include "fpga/fpga_stereo_matcher.h"
-#include "fpga/sgm_matcher.h"
 #include "fpga/sgm_registers.h"
 #include "fpga/simulated_stereo_device.h"
-#include "fpga/stereo_test_pair.h"
 #include "fpga/uio_stereo_device.h"
+#include "stereo/sgm_matcher.h"
+#include "stereo/testing/stereo_test_pair.h"
 
 namespace cairn {
 namespace {

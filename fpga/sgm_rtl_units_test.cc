@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "fpga/cosim/sgm_unit_bench_model.h"
-#include "fpga/sgm_kernels.h"
-#include "fpga/stereo_matcher_interface.h"
+#include "stereo/sgm_kernels.h"
+#include "stereo/stereo_matcher_interface.h"
 
 namespace cairn {
 namespace {

@@ -10,10 +10,10 @@
 #include <memory>
 #include <string>
 
+#include "common/options_visitor.h"
 #include "fpga/fpga_stereo_matcher.h"
-#include "fpga/sgm_matcher.h"
 #include "fpga/stereo_device.h"
-#include "hal/options_visitor.h"
+#include "stereo/sgm_matcher.h"
 
 namespace cairn {
 

@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "fpga/simulated_stereo_device.h"
-#include "fpga/stereo_test_pair.h"
 #include "fpga/stereo_backend_switch.h"
+#include "stereo/testing/stereo_test_pair.h"
 
 namespace cairn {
 namespace {

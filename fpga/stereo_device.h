@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "hal/status.h"
+#include "common/status.h"
 
 namespace cairn {
 

@@ -2,7 +2,7 @@
 
 #include <Eigen/Core>
 
-#include "hal/timestamp.h"
+#include "common/timestamp.h"
 
 namespace cairn {
 

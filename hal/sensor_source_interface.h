@@ -2,8 +2,8 @@
 
 #include <string>
 
+#include "common/status.h"
 #include "hal/sensor_sink.h"
-#include "hal/status.h"
 
 namespace cairn {
 

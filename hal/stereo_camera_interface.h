@@ -1,8 +1,8 @@
 #pragma once
 
+#include "common/timestamp.h"
 #include "hal/calibration.h"
 #include "hal/sensor_source_interface.h"
-#include "hal/timestamp.h"
 
 namespace cairn {
 

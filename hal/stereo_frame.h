@@ -2,8 +2,8 @@
 
 #include <cstdint>
 
+#include "common/timestamp.h"
 #include "hal/image.h"
-#include "hal/timestamp.h"
 
 namespace cairn {
 

@@ -2,7 +2,7 @@
 
 #include <cstdint>
 
-#include "hal/timestamp.h"
+#include "common/timestamp.h"
 
 namespace cairn {
 

@@ -3,7 +3,7 @@
 #include <array>
 #include <cstdint>
 
-#include "hal/timestamp.h"
+#include "common/timestamp.h"
 
 namespace cairn {
 

@@ -17,7 +17,7 @@
 
 #include "mapping/depth_image.h"
 #include "mapping/mapping_options.h"
-#include "mapping/stereo_error_model.h"
+#include "stereo/stereo_error_model.h"
 
 namespace cairn {
 

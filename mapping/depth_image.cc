@@ -39,7 +39,7 @@ Expected<DepthImage> DepthImage::FromDisparity(std::span<const int16_t> disparit
   if (!(focal_px > 0.0) || !(baseline > 0.0)) {
     return InvalidArgumentError("disparity to depth needs positive focal length and baseline");
   }
-  // Must match fpga/stereo_matcher_interface.h (kDisparityScale, kInvalidDisparity); mapping sits
+  // Must match stereo/stereo_matcher_interface.h (kDisparityScale, kInvalidDisparity); mapping sits
   // below fpga in the dependency order, so the contract is restated here and tested there.
   constexpr double kScale = 16.0;
   constexpr int16_t kInvalid = std::numeric_limits<int16_t>::min();

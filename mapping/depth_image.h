@@ -7,9 +7,9 @@
 
 #include <Eigen/Geometry>
 
+#include "common/status.h"
+#include "common/timestamp.h"
 #include "hal/calibration.h"
-#include "hal/status.h"
-#include "hal/timestamp.h"
 
 namespace cairn {
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "mapping/mapping_test_scenes.h"
+#include "mapping/testing/mapping_test_scenes.h"
 
 namespace cairn {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "hal/timestamp.h"
+#include "common/timestamp.h"
 
 namespace cairn {
 

@@ -20,7 +20,7 @@
 #include <Eigen/Geometry>
 #include <octomap/OcTree.h>
 
-#include "hal/status.h"
+#include "common/status.h"
 #include "mapping/mapping_options.h"
 #include "mapping/submap.h"
 #include "mapping/submap_resampler.h"

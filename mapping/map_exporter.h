@@ -8,7 +8,7 @@
 
 #include <octomap/OcTree.h>
 
-#include "hal/status.h"
+#include "common/status.h"
 #include "mapping/grid_map.h"
 #include "mapping/voxel_cloud.h"
 

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "mapping/submap_test_util.h"
+#include "mapping/testing/submap_test_util.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {

@@ -1,11 +1,11 @@
 #pragma once
 // Options of the local mapping modules (thesis 5.1, 5.2.2), each with key, unit and range through
-// Visit() (hal/options_visitor.h). Defaults are the thesis' values where it gives one.
+// Visit() (common/options_visitor.h). Defaults are the thesis' values where it gives one.
 
 #include <cstdint>
 #include <string>
 
-#include "hal/options_visitor.h"
+#include "common/options_visitor.h"
 
 namespace cairn {
 

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "daemon/yaml_options_reader.h"
+#include "common/yaml_options_reader.h"
 
 namespace cairn {
 namespace {

@@ -11,7 +11,7 @@
 
 #include <octomap/OcTree.h>
 
-#include "hal/timestamp.h"
+#include "common/timestamp.h"
 #include "mapping/mapping_options.h"
 #include "mapping/occupancy_integrator.h"
 #include "mapping/voxel_cloud.h"

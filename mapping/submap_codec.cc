@@ -8,9 +8,9 @@
 #include <sstream>
 #include <string>
 
-#include "drivers/mcap/byte_reader.h"
-#include "drivers/mcap/byte_writer.h"
-#include "drivers/mcap/crc32.h"
+#include "io/byte_reader.h"
+#include "io/byte_writer.h"
+#include "io/crc32.h"
 
 namespace cairn {
 namespace {
@@ -132,7 +132,7 @@ Status SubmapCodec::ValidateOctreeBinary(std::span<const uint8_t> data) {
   return Status::Ok();
 }
 
-Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, McapCompression compression) {
+Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compression compression) {
   const SubmapMetadata& m = submap.metadata();
   if (m.robot.size() > 255) return InvalidArgumentError("submap robot name longer than 255 bytes");
   ByteWriter w;
@@ -232,7 +232,7 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, McapCom
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(tree.data()), tree.size()));
 
   std::vector<uint8_t> compressed;
-  CAIRN_RETURN_IF_ERROR(ChunkCodec::Compress(compression, w.buffer(), &compressed, kZstdLevel));
+  CAIRN_RETURN_IF_ERROR(Compressor::Compress(compression, w.buffer(), &compressed, kZstdLevel));
   ByteWriter out;
   out.Bytes(std::span(reinterpret_cast<const uint8_t*>(kMagic), sizeof(kMagic)));
   out.U16(kVersion);
@@ -266,7 +266,7 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
                          std::to_string(kVersion) + ")");
   }
   if (reserved != 0) return DataLossError("submap header reserved byte is " + std::to_string(reserved));
-  if (compression > static_cast<uint8_t>(McapCompression::kLz4)) return DataLossError("submap has unknown compression " + std::to_string(compression));
+  if (compression > static_cast<uint8_t>(Compression::kLz4)) return DataLossError("submap has unknown compression " + std::to_string(compression));
   if (raw_size > kMaxPayload) return DataLossError("submap payload size " + std::to_string(raw_size) + " is implausible");
   if (packed_size != h.remaining()) {
     return DataLossError("submap body is " + std::to_string(h.remaining()) + " bytes, header says " + std::to_string(packed_size));
@@ -274,7 +274,7 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   const auto packed = h.Take(packed_size);
   if (Crc32::Of(packed) != packed_crc) return DataLossError("submap checksum mismatch (compressed body)");
   std::vector<uint8_t> raw;
-  const Status st = ChunkCodec::Decompress(static_cast<McapCompression>(compression), packed, raw_size, &raw);
+  const Status st = Compressor::Decompress(static_cast<Compression>(compression), packed, raw_size, &raw);
   if (!st.ok()) return DataLossError("submap body does not decompress: " + st.message());
   if (Crc32::Of(raw) != raw_crc) return DataLossError("submap checksum mismatch (payload)");
 

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "drivers/mcap/chunk_codec.h"
-#include "hal/status.h"
+#include "common/status.h"
+#include "io/compression.h"
 #include "mapping/submap.h"
 
 namespace cairn {
@@ -29,7 +29,7 @@ class SubmapCodec {
   static constexpr uint16_t kVersion = 2;
 
   static Expected<std::vector<uint8_t>> Encode(const Submap& submap,
-                                               McapCompression compression = McapCompression::kZstd);
+                                               Compression compression = Compression::kZstd);
   // Validates everything (magic, version, sizes, checksums, every field and the tree structure)
   // and names the first problem.
   static Expected<std::shared_ptr<const Submap>> Decode(std::span<const uint8_t> bytes);

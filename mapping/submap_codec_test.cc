@@ -6,14 +6,14 @@
 
 #include <gtest/gtest.h>
 
-#include "mapping/submap_test_util.h"
+#include "mapping/testing/submap_test_util.h"
 
 namespace cairn {
 namespace {
 
 TEST(SubmapCodecTest, RoundTripKeepsMetadataQuantizedCloudAndOccupancy) {
   const auto submap = testing::SyntheticSubmap(7);
-  for (McapCompression c : {McapCompression::kZstd, McapCompression::kLz4}) {
+  for (Compression c : {Compression::kZstd, Compression::kLz4}) {
     auto bytes = SubmapCodec::Encode(*submap, c);
     ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
     auto back = SubmapCodec::Decode(*bytes);

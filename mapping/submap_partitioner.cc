@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "estimation/symmetric_eigen.h"
+#include "estimation/math/symmetric_eigen.h"
 
 namespace cairn {
 

@@ -16,13 +16,13 @@
 #include <octomap/OcTree.h>
 
 #include "daemon/simulated_map_accuracy.h"
-#include "drivers/simulator/terrain.h"
-#include "drivers/simulator/world_file.h"
-#include "estimation/g2o_io.h"
-#include "estimation/trajectory.h"
-#include "estimation/trajectory_evaluator.h"
+#include "estimation/eval/trajectory.h"
+#include "estimation/eval/trajectory_evaluator.h"
+#include "estimation/graph/g2o_io.h"
 #include "mapping/map_exporter.h"
 #include "mapping/submap_codec.h"
+#include "sim/terrain.h"
+#include "sim/world_file.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
@@ -140,7 +140,7 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
   // other robot are off the terrain; they are few.)
   EXPECT_LT(err[err.size() / 2], 0.05) << "median height error";
   EXPECT_LT(err[err.size() * 9 / 10], 0.15) << "90th percentile height error";
-  // The voxel map (issue 10): >= 95 % of the occupied voxels within one voxel of a true surface
+  // The voxel map: >= 95 % of the occupied voxels within one voxel of a true surface
   // (the terrain, the lander, the robots where they were), as `cairn summary` scores it.
   const auto accuracy = ScoreSimulatedMap(out + "/a", T_world_first);
   ASSERT_TRUE(accuracy.ok()) << accuracy.status().ToString();
@@ -190,7 +190,7 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
   }
 }
 
-// Issue 10's map accuracy where it is hardest: the hexacopter's 20 s demo flight, 3.5-5 m above
+// The map accuracy target where it is hardest: the hexacopter's 20 s demo flight, 3.5-5 m above
 // the ground with a 0.12 m baseline (one image's depth error there is 3-6 voxels). The map goes
 // through every stage: rendered pairs, SGM both ways, VO, filter, fusion, submaps, composition;
 // it is placed in the world by the trajectory's alignment, as `cairn summary` does.

@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "drivers/mcap/mcap_reader.h"
-#include "drivers/mcap/mcap_writer.h"
+#include "io/mcap/mcap_reader.h"
+#include "io/mcap/mcap_writer.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"

@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "estimation/trajectory.h"
+#include "estimation/eval/trajectory.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"

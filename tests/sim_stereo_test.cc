@@ -12,12 +12,12 @@
 
 #include <opencv2/calib3d.hpp>
 
-#include "drivers/simulator/mission_simulator.h"
-#include "fpga/bidirectional_raster_matcher.h"
-#include "fpga/disparity_evaluator.h"
-#include "fpga/opencv_sgbm_matcher.h"
-#include "fpga/sgm_matcher.h"
-#include "fpga/stereo_image_io.h"
+#include "sim/mission_simulator.h"
+#include "stereo/bidirectional_raster_matcher.h"
+#include "stereo/disparity_evaluator.h"
+#include "stereo/opencv_sgbm_matcher.h"
+#include "stereo/sgm_matcher.h"
+#include "stereo/stereo_image_io.h"
 
 namespace cairn {
 namespace {

@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "common/options_yaml_writer.h"
 #include "daemon/cairnd_config.h"
-#include "daemon/options_yaml_writer.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

@@ -17,8 +17,8 @@
 #include <thread>
 #include <vector>
 
-#include "daemon/executor.h"
-#include "estimation/filter_scenario.h"
+#include "daemon/pipeline/executor.h"
+#include "estimation/testing/filter_scenario.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

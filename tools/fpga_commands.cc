@@ -11,9 +11,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fpga/fpga_stereo_matcher.h"
-#include "fpga/sgm_matcher.h"
 #include "fpga/simulated_stereo_device.h"
-#include "fpga/stereo_image_io.h"
+#include "stereo/sgm_matcher.h"
+#include "stereo/stereo_image_io.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

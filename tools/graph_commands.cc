@@ -11,13 +11,13 @@
 
 #include <Eigen/Geometry>
 
-#include "estimation/g2o_io.h"
-#include "estimation/graph_replay.h"
-#include "estimation/graph_worker.h"
-#include "estimation/ordered_draws.h"
-#include "estimation/pose_graph_solver.h"
-#include "estimation/slam_graph.h"
-#include "estimation/so3.h"
+#include "estimation/graph/g2o_io.h"
+#include "estimation/graph/graph_replay.h"
+#include "estimation/graph/graph_worker.h"
+#include "estimation/graph/pose_graph_solver.h"
+#include "estimation/graph/slam_graph.h"
+#include "estimation/math/ordered_draws.h"
+#include "estimation/math/so3.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
@@ -310,7 +310,7 @@ int RunGraphInject(const CommandArgs& args) {
     PoseGraphEdge e = g.edges()[closures.empty() ? template_edge(rng) : closures[template_edge(rng)]];
     e.from = g.ids()[i];
     e.to = g.ids()[j];
-    // Last component first (estimation/ordered_draws.h).
+    // Last component first (estimation/math/ordered_draws.h).
     const double z = planar ? 0.0 : s * uniform(rng);
     const double y = s * uniform(rng);
     const double x = s * uniform(rng);

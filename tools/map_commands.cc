@@ -14,14 +14,14 @@
 #include <string>
 #include <vector>
 
-#include "daemon/atomic_file.h"
+#include "common/atomic_file.h"
 #include "mapping/depth_fusion.h"
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
 #include "mapping/map_exporter.h"
-#include "mapping/obstacle_ground_truth.h"
-#include "mapping/sim_depth_scenes.h"
 #include "mapping/submap_codec.h"
+#include "sim/obstacle_ground_truth.h"
+#include "sim/testing/sim_depth_scenes.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
@@ -282,7 +282,7 @@ int RunBenchMap(const CommandArgs& args) {
               classify_ms, project_ms, classify_ms + project_ms, classify_cpu, project_cpu, classify_cpu + project_cpu);
   std::printf("  integration into the open submap (cloud + octree): median %.2f ms (CPU %.2f ms)  target <= 10 ms\n",
               integrate_ms, Median(c_integrate));
-  std::printf("  obstacle cells vs ground truth (mapping/obstacle_ground_truth.h): precision %.3f recall %.3f (tp %lld fp %lld "
+  std::printf("  obstacle cells vs ground truth (sim/obstacle_ground_truth.h): precision %.3f recall %.3f (tp %lld fp %lld "
               "fn %lld; %lld cells within the stereo error of h_max or undetectable edges unscored, %lld of them steep hidden "
               "drops whose visible ends are not, eq. 5.1)  target >= 0.95 / 0.90\n"
               "    with a fixed 0.03 m band instead of the stereo error: precision %.3f recall %.3f (tp %lld fp %lld fn %lld)\n",
@@ -327,7 +327,7 @@ int RunBenchMap(const CommandArgs& args) {
   auto bytes = SubmapCodec::Encode(*submap);
   const double encode_ms = Ms(t_enc, Clock::now());
   if (!bytes.ok()) return Fail(bytes.status());
-  auto lz4 = SubmapCodec::Encode(*submap, McapCompression::kLz4);
+  auto lz4 = SubmapCodec::Encode(*submap, Compression::kLz4);
   const auto t_dec = Clock::now();
   auto back = SubmapCodec::Decode(*bytes);
   const double decode_ms = Ms(t_dec, Clock::now());

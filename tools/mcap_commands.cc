@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <string>
 
-#include "daemon/json_writer.h"
-#include "drivers/mcap/mcap_reader.h"
+#include "common/json_writer.h"
+#include "io/mcap/mcap_reader.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

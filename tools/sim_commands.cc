@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "daemon/cairnd_config.h"
-#include "drivers/simulator/mission_simulator.h"
-#include "drivers/simulator/world_file.h"
+#include "sim/mission_simulator.h"
+#include "sim/world_file.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

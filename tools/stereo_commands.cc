@@ -15,15 +15,15 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "drivers/euroc_dataset.h"
-#include "fpga/disparity_evaluator.h"
+#include "drivers/replay/euroc_dataset.h"
 #include "fpga/fpga_stereo_matcher.h"
-#include "fpga/bidirectional_raster_matcher.h"
-#include "fpga/opencv_sgbm_matcher.h"
-#include "fpga/sgm_matcher.h"
 #include "fpga/simulated_stereo_device.h"
-#include "fpga/stereo_image_io.h"
-#include "fpga/stereo_rectifier.h"
+#include "stereo/bidirectional_raster_matcher.h"
+#include "stereo/disparity_evaluator.h"
+#include "stereo/opencv_sgbm_matcher.h"
+#include "stereo/sgm_matcher.h"
+#include "stereo/stereo_image_io.h"
+#include "stereo/stereo_rectifier.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

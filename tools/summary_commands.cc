@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <optional>
 
-#include "daemon/json_value.h"
+#include "common/json_value.h"
 #include "daemon/simulated_map_accuracy.h"
-#include "estimation/trajectory.h"
-#include "estimation/trajectory_evaluator.h"
+#include "estimation/eval/trajectory.h"
+#include "estimation/eval/trajectory_evaluator.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <string>
 
-#include "daemon/atomic_file.h"
-#include "estimation/trajectory.h"
+#include "common/atomic_file.h"
+#include "estimation/eval/trajectory.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

@@ -14,11 +14,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "daemon/json_writer.h"
-#include "daemon/stereo_rectify_stage.h"
-#include "drivers/euroc_dataset.h"
-#include "estimation/keyframe_visual_odometry.h"
-#include "estimation/trajectory_evaluator.h"
+#include "common/json_writer.h"
+#include "daemon/pipeline/stereo_rectify_stage.h"
+#include "drivers/replay/euroc_dataset.h"
+#include "estimation/eval/trajectory_evaluator.h"
+#include "estimation/vo/keyframe_visual_odometry.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {

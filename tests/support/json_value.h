@@ -1,7 +1,7 @@
 #pragma once
 // Tests read JSON with the daemon's reader.
 
-#include "daemon/json_value.h"
+#include "common/json_value.h"
 
 namespace cairn::testing {
 using cairn::JsonValue;

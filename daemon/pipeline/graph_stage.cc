@@ -1,0 +1,213 @@
+#include "daemon/pipeline/graph_stage.h"
+
+#include "common/monotonic_clock.h"
+
+namespace cairn {
+namespace {
+
+Pose3 ToPose3(const Eigen::Isometry3d& T) {
+  return Pose3{T.translation(), Eigen::Quaterniond(T.rotation()).normalized()};
+}
+
+Eigen::Isometry3d ToIsometry(const Pose3& p) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = p.R();
+  T.translation() = p.t;
+  return T;
+}
+
+constexpr size_t kMaxErrors = 10;
+
+}  // namespace
+
+GraphStage::GraphStage(const GraphStageOptions& options, bool deterministic)
+    : options_([&] {
+        GraphStageOptions o = options;
+        // Deterministic replays bound each update by its iterations only: a time bound would make
+        // the optimum depend on the machine's load.
+        if (deterministic) o.optimizer.update_seconds = 1e9;
+        return o;
+      }()),
+      graph_(options_.optimizer),
+      robot_(options_.optimizer.own_robot) {}
+
+uint64_t GraphStage::OriginKey(uint64_t frame_id) const {
+  return VariableKey(VariableKind::kSubmap, robot_, frame_id);
+}
+
+Matrix6d GraphStage::Floored(const Matrix6d& covariance) const {
+  Matrix6d c = 0.5 * (covariance + covariance.transpose());
+  for (int i = 0; i < 3; ++i) c(i, i) += options_.min_position_sigma * options_.min_position_sigma;
+  for (int i = 3; i < 6; ++i) c(i, i) += options_.min_rotation_sigma * options_.min_rotation_sigma;
+  return c;
+}
+
+void GraphStage::Error(const std::string& what) {
+  if (report_.errors.size() < kMaxErrors) report_.errors.push_back(what);
+}
+
+bool GraphStage::Add(const SlamFactor& f) {
+  Status s = Status::Ok();
+  if (!f.information.allFinite() || !f.z.t.allFinite() || !f.z.q.coeffs().allFinite()) {
+    s = InvalidArgumentError("factor " + std::to_string(static_cast<int>(f.kind)) + " with a non-finite measurement or covariance");
+  } else {
+    s = graph_.AddFactor(f);
+  }
+  if (!s.ok()) {
+    ++report_.rejected_factors;
+    Error(s.ToString());
+    return false;
+  }
+  ++report_.factors;
+  return true;
+}
+
+void GraphStage::Update() {
+  const MonotonicClock clock;
+  const Timestamp start = clock.Now();
+  const SlamUpdateStats stats = graph_.Update();
+  update_time_.Record(clock.Now() - start);
+  if (stats.solved) ++report_.solves;
+  if (stats.reinitialized) ++report_.reinitializations;
+}
+
+void GraphStage::OnInput(const GraphInput& input) {
+  if (input.kind == GraphInput::Kind::kEstimate) {
+    OnEstimate(input.estimate);
+  } else {
+    OnFrameSwitch(input.frame_switch);
+  }
+}
+
+void GraphStage::OnEstimate(const FrameEstimate& e) {
+  if (!e.valid) return;
+  ++report_.estimates;
+  if (!started_) {
+    // The filter's first frame is the global frame: the prior holds its origin at the identity.
+    SlamFactor prior;
+    prior.kind = FactorKind::kPrior;
+    prior.a = OriginKey(e.frame_id);
+    prior.information = Floored(Matrix6d::Zero()).inverse();
+    Add(prior);
+    ++report_.submap_origins;
+    started_ = true;
+  }
+  if (!graph_.HasVariable(OriginKey(e.frame_id))) {
+    ++report_.unplaced;
+    return;
+  }
+  estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
+  if ((estimates_.size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
+  SlamFactor v;
+  v.kind = FactorKind::kFilterEstimate;
+  v.a = OriginKey(e.frame_id);
+  v.b = VariableKey(VariableKind::kRobotPose, robot_, next_pose_++);
+  v.z = ToPose3(e.T_frame_body);
+  v.information = Floored(e.pose_covariance).inverse();
+  if (!Add(v)) return;
+  ++report_.robot_poses;
+  Update();
+}
+
+void GraphStage::OnFrameSwitch(const FrameSwitchEvent& e) {
+  if (!started_ || !graph_.HasVariable(OriginKey(e.old_frame_id))) {
+    // A switch before the first estimate (none: the filter switches only once initialized) or
+    // from a frame the graph never saw.
+    ++report_.unplaced;
+    Error("frame switch " + std::to_string(e.old_frame_id) + " -> " + std::to_string(e.new_frame_id) +
+          " from a frame not in the graph");
+    return;
+  }
+  SlamFactor w;
+  w.kind = FactorKind::kFrameSwitch;
+  w.a = OriginKey(e.old_frame_id);
+  w.b = OriginKey(e.new_frame_id);
+  w.z = ToPose3(e.transform.T_old_new);
+  w.information = Floored(e.transform.covariance).inverse();
+  if (!Add(w)) {
+    ++report_.unplaced;  // the new frame stays unknown: its estimates are counted as unplaced
+    return;
+  }
+  ++report_.frame_switches;
+  ++report_.submap_origins;
+  Update();
+}
+
+void GraphStage::Finish() {
+  if (graph_.num_factors() == 0) return;
+  const SlamUpdateStats stats = graph_.SolveFull();
+  if (stats.solved) ++report_.solves;
+  report_.final_cost = stats.cost;
+  report_.chi2 = graph_.Chi2();
+  report_.unconnected_variables = graph_.Unconnected().size();
+}
+
+GraphStageReport GraphStage::report() const { return report_; }
+
+std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins() const {
+  std::map<uint64_t, Eigen::Isometry3d> out;
+  for (uint64_t key : graph_.VariableKeys()) {
+    if (KindOfKey(key) != VariableKind::kSubmap || RobotOfVariable(key) != robot_) continue;
+    if (auto p = graph_.Pose(key); p.ok()) out[IndexOfVariable(key)] = ToIsometry(*p);
+  }
+  return out;
+}
+
+Trajectory GraphStage::GlobalTrajectory() const {
+  Trajectory t;
+  t.frame = "global";
+  const auto origins = FrameOrigins();
+  t.poses.reserve(estimates_.size());
+  for (const Placed& e : estimates_) {
+    const auto origin = origins.find(e.frame_id);
+    if (origin == origins.end()) continue;
+    t.poses.push_back(StampedPose{e.time, origin->second * e.T_frame_body});
+  }
+  return t;
+}
+
+GraphScene GraphStage::Scene(bool covariances) {
+  GraphScene scene;
+  std::vector<uint64_t> origin_keys;
+  for (uint64_t key : graph_.VariableKeys()) {
+    auto p = graph_.Pose(key);
+    if (!p.ok()) continue;
+    GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero()};
+    if (KindOfKey(key) == VariableKind::kSubmap) {
+      scene.origins.push_back(node);
+      origin_keys.push_back(key);
+    } else {
+      scene.poses.push_back(node);
+    }
+  }
+  if (covariances && !origin_keys.empty()) {
+    auto cov = graph_.Covariances(origin_keys);
+    if (cov.ok()) {
+      for (size_t i = 0; i < origin_keys.size(); ++i) origin_covariance_[origin_keys[i]] = (*cov)[i].topLeftCorner<3, 3>();
+    } else {
+      Error("covariances for the live view: " + cov.status().ToString());
+    }
+  }
+  for (GraphScene::Node& n : scene.origins) {
+    if (const auto c = origin_covariance_.find(n.key); c != origin_covariance_.end()) n.position_covariance = c->second;
+  }
+  for (const SlamFactor& f : graph_.factors()) {
+    if (!IsUnary(f.kind)) scene.edges.push_back(GraphScene::Edge{f.a, f.b, f.kind});
+  }
+  return scene;
+}
+
+PoseGraph GraphStage::ExportPoseGraph() const {
+  PoseGraph g;
+  for (uint64_t key : graph_.VariableKeys()) {
+    if (auto p = graph_.Pose(key); p.ok()) g.SetVertex(key, *p);
+  }
+  g.set_has_initial_estimate(true);
+  for (const SlamFactor& f : graph_.factors()) {
+    // Not the prior: g2o readers take the first vertex as the gauge.
+    if (!IsUnary(f.kind)) g.AddEdge(EdgeOfFactor(f));
+  }
+  return g;
+}
+
+}  // namespace cairn

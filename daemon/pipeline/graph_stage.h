@@ -1,0 +1,98 @@
+#pragma once
+// The graph executor's work: the robot's SLAM graph (estimation/graph/slam_graph.h) fed online with the
+// filter's output, in the filter topology of thesis Fig. 4.2b. Each local frame of the filter is a
+// submap origin s (the first one carries the prior and is the global frame); each frame switch
+// is a factor w between consecutive origins; every `pose_every`-th estimate is a robot pose x with
+// its factor v from its frame's origin. Inputs come in the order the estimation thread made them,
+// and in deterministic replays the optimizer is bounded by iterations only, so a replay gives the
+// same graph bit for bit. Not thread safe: one graph thread owns it.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "daemon/pipeline/estimation_stage.h"
+#include "daemon/pipeline/graph_stage_options.h"
+#include "daemon/pipeline/latency_histogram.h"
+#include "daemon/telemetry/graph_scene.h"
+#include "estimation/eval/trajectory.h"
+#include "estimation/graph/pose_graph.h"
+#include "estimation/graph/slam_graph.h"
+
+namespace cairn {
+
+struct GraphStageReport {
+  uint64_t estimates = 0;        // valid filter estimates received
+  uint64_t frame_switches = 0;   // switches added as w factors
+  uint64_t submap_origins = 0;
+  uint64_t robot_poses = 0;
+  uint64_t factors = 0;
+  uint64_t solves = 0;           // updates that re-optimized
+  uint64_t reinitializations = 0;
+  uint64_t rejected_factors = 0;
+  // Estimates or switches the graph could not place: their frame is not connected to the chain
+  // (an input was lost upstream). Counted, never guessed.
+  uint64_t unplaced = 0;
+  uint64_t unconnected_variables = 0;
+  double chi2 = 0.0;             // after the final solve
+  double final_cost = 0.0;
+  std::vector<std::string> errors;  // the first few, verbatim
+};
+
+class GraphStage {
+ public:
+  GraphStage(const GraphStageOptions& options, bool deterministic);
+
+  // Full solves after loop closures go through `runner` (live); without one they run inline.
+  void SetBackgroundRunner(SlamGraph::BackgroundRunner runner) { graph_.SetBackgroundRunner(std::move(runner)); }
+  void OnInput(const GraphInput& input);
+  // End of the run: waits for a running full solve, then optimizes to convergence.
+  void Finish();
+
+  GraphStageReport report() const;
+  char robot() const { return robot_; }
+  // Time of the last estimate placed, and the number of submap origins (cheap, for live updates).
+  Timestamp last_time() const { return estimates_.empty() ? Timestamp() : estimates_.back().time; }
+  uint64_t submap_origins() const { return report_.submap_origins; }
+  const LatencyHistogram& update_time() const { return update_time_; }
+  // T_global_frame of every local frame in the graph (global = the first frame).
+  std::map<uint64_t, Eigen::Isometry3d> FrameOrigins() const;
+  // Every valid estimate received, placed by its frame's optimized origin (eq. 4.6).
+  Trajectory GlobalTrajectory() const;
+  // The graph's variables (optimized) and binary factors, for g2o export. Keys carry the robot
+  // letter in the top byte and the kind ('s' origin, 'x' pose) in the next.
+  PoseGraph ExportPoseGraph() const;
+  // The graph now, with the origins' marginal covariances as last computed; `covariances`
+  // computes them again (a Ceres covariance solve over the graph: the live view asks at each new
+  // origin, not at every pose).
+  GraphScene Scene(bool covariances);
+
+ private:
+  void OnEstimate(const FrameEstimate& e);
+  void OnFrameSwitch(const FrameSwitchEvent& e);
+  bool Add(const SlamFactor& f);
+  void Update();
+  void Error(const std::string& what);
+  Matrix6d Floored(const Matrix6d& covariance) const;
+  uint64_t OriginKey(uint64_t frame_id) const;
+
+  GraphStageOptions options_;
+  SlamGraph graph_;
+  char robot_ = 'a';
+  bool started_ = false;
+  uint64_t next_pose_ = 0;
+  struct Placed {
+    Timestamp time;
+    uint64_t frame_id = 0;
+    Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
+  };
+  std::vector<Placed> estimates_;
+  std::map<uint64_t, Eigen::Matrix3d> origin_covariance_;  // of the live view, as last computed
+  LatencyHistogram update_time_;
+  GraphStageReport report_;
+};
+
+}  // namespace cairn

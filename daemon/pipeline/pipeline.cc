@@ -1,0 +1,498 @@
+#include "daemon/pipeline/pipeline.h"
+
+#include "common/monotonic_clock.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <thread>
+
+namespace cairn {
+namespace {
+
+int64_t MonotonicNs() { return MonotonicClock().Now().nanoseconds(); }
+
+}  // namespace
+
+Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues,
+                   PipelineRates rates, bool deterministic)
+    : deterministic_(deterministic),
+      imu_queue_(static_cast<size_t>(queues.imu)),
+      wheel_queue_(static_cast<size_t>(queues.wheel_odometry)),
+      trigger_queue_(static_cast<size_t>(queues.wheel_odometry)),
+      stereo_queue_(static_cast<size_t>(queues.stereo)),
+      rectified_queue_(static_cast<size_t>(queues.vo)),
+      clone_queue_(64),
+      vo_result_queue_(32),
+      switch_queue_(8),
+      estimate_queue_(256),
+      estimation_inputs_(imu_queue_, wheel_queue_, trigger_queue_, clone_queue_, vo_result_queue_, switch_queue_),
+      dense_queue_(static_cast<size_t>(queues.dense)),
+      mapping_estimate_queue_(256),
+      switch_event_queue_(16),
+      graph_queue_(static_cast<size_t>(queues.graph)),
+      imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
+      estimation_exec_("estimation", executors.estimation),
+      stereo_("stereo", executors.stereo),
+      vo_("vo", executors.vo),
+      mapping_exec_("mapping", executors.mapping),
+      graph_exec_("graph", executors.graph),
+      graph_full_solve_exec_("graph_full_solve", executors.graph_full_solve),
+      imu_stats_(rates.imu_hz),
+      wheel_stats_(rates.wheel_hz),
+      trigger_stats_(rates.camera_hz),
+      stereo_stats_(rates.camera_hz) {
+  // spdlog creates its default logger on first use, inside its uninstrumented shared library, so
+  // ThreadSanitizer cannot see that construction is ordered before the other threads' reads.
+  // Creating it here, before any thread logs through the pipeline, makes the order explicit.
+  spdlog::default_logger_raw();
+}
+
+Pipeline::~Pipeline() { StopAndDrain(); }
+
+Status Pipeline::EnableEstimation(const EstimationSetup& setup) {
+  if (started_) return FailedPreconditionError("EnableEstimation() after Start()");
+  if (!setup.vo.enabled) return Status::Ok();
+  // Buffers for the pairs waiting in the queues, the ones in the odometry and in dense matching,
+  // and the one being written.
+  auto rectify =
+      StereoRectifyStage::Create(setup.stereo, rectified_queue_.capacity() + dense_queue_.capacity() + 3);
+  if (!rectify.ok()) return rectify.status().WithContext("stereo calibration");
+  rectify_ = std::move(*rectify);
+  vo_stage_ = std::make_unique<VoStage>(setup.vo, setup.frame_switch, rectify_->camera(), rectify_->T_body_cam());
+  estimation_ = std::make_unique<EstimationStage>(setup.filter, setup.imu, setup.wheels, &estimate_queue_);
+  return Status::Ok();
+}
+
+Status Pipeline::EnableMapping(const MappingSetup& setup) {
+  if (started_) return FailedPreconditionError("EnableMapping() after Start()");
+  if (!estimation_) return FailedPreconditionError("mapping needs the estimation chain (vo.enabled)");
+  MappingSetup with_camera = setup;  // the rectified camera the odometry sees, too
+  with_camera.camera = rectify_->camera();
+  with_camera.T_body_cam = rectify_->T_body_cam();
+  auto stage = MappingStage::Create(with_camera, this);
+  if (!stage.ok()) return stage.status();
+  mapping_ = std::move(*stage);
+  dense_every_ = setup.stereo.every_nth_frame;
+  estimation_->AlsoPublishTo(&mapping_estimate_queue_, &switch_event_queue_);
+  return Status::Ok();
+}
+
+Status Pipeline::EnableGraph(const GraphStageOptions& options) {
+  if (started_) return FailedPreconditionError("EnableGraph() after Start()");
+  if (!estimation_) return FailedPreconditionError("the graph needs the estimation chain (vo.enabled)");
+  graph_ = std::make_unique<GraphStage>(options, deterministic_);
+  // Live, full solves after loop closures run on their own executor; replays solve them inline so
+  // that the result does not depend on thread timing.
+  if (!deterministic_) graph_->SetBackgroundRunner(graph_worker_.Runner());
+  estimation_->PublishToGraph(&graph_queue_);
+  return Status::Ok();
+}
+
+void Pipeline::SetTelemetry(TelemetryStage* telemetry) {
+  telemetry_ = telemetry;
+  if (mapping_) mapping_->SetTelemetry(telemetry);
+}
+
+MappingStageReport Pipeline::mapping_report() const {
+  MappingStageReport r = mapping_ ? mapping_->report() : MappingStageReport{};
+  r.switch_requests = mapping_switch_requests_;
+  return r;
+}
+
+void Pipeline::Start() {
+  if (started_) return;
+  started_ = true;
+  filter_running_.store(true, std::memory_order_release);
+  estimation_exec_.Start([this](std::stop_token stop) { EstimationLoop(stop); });
+  stereo_.Start([this](std::stop_token stop) { StereoLoop(stop); });
+  if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
+  if (mapping_) mapping_exec_.Start([this](std::stop_token stop) { MappingLoop(stop); });
+  if (graph_) graph_exec_.Start([this](std::stop_token stop) { GraphLoop(stop); });
+  if (graph_ && !deterministic_) {
+    graph_full_solve_exec_.Start([this](std::stop_token stop) { graph_worker_.Run(stop); });
+  }
+}
+
+void Pipeline::StopAndDrain() {
+  if (!started_) return;
+  // Upstream first, so that every stage drains into a consumer that still runs (in deterministic
+  // mode a producer waits for its consumer).
+  stereo_.RequestStop();
+  stereo_signal_.Notify();
+  stereo_.Join();
+  if (estimation_) {
+    vo_.RequestStop();
+    vo_signal_.Notify();
+    vo_.Join();
+  }
+  // Mapping after the odometry (its pairs are all in) but before the filter: in deterministic
+  // mode its frame-switch requests wait for the estimation thread.
+  if (mapping_) {
+    mapping_exec_.RequestStop();
+    mapping_signal_.Notify();
+    mapping_exec_.Join();
+  }
+  filter_running_.store(false, std::memory_order_release);
+  estimation_exec_.RequestStop();
+  estimation_signal_.Notify();
+  estimation_exec_.Join();
+  // The graph takes everything the filter made, then solves to convergence.
+  if (graph_) {
+    graph_exec_.RequestStop();
+    graph_signal_.Notify();
+    graph_exec_.Join();
+    graph_->Finish();  // waits for a running full solve, so its worker stops after it
+    graph_full_solve_exec_.RequestStop();
+    graph_full_solve_exec_.Join();
+  }
+  // What the filter emitted last is mapped too; the open submap is finished and the map written.
+  if (mapping_) {
+    TakeMappingInputs();
+    if (graph_) {
+      const auto origins = graph_->FrameOrigins();
+      mapping_->Finish(&origins);
+    } else {
+      mapping_->Finish();
+    }
+  }
+  // Estimates emitted after the odometry stopped.
+  if (vo_stage_) {
+    while (const FrameEstimate* e = estimate_queue_.Front()) {
+      vo_stage_->OnEstimate(*e);
+      if (e->valid && telemetry_ != nullptr) telemetry_->OfferPose(e->time, e->T_first_body);
+      estimate_queue_.PopFront();
+    }
+  }
+  started_ = false;
+}
+
+template <class T>
+void Pipeline::Publish(SpscQueue<Queued<T>>& queue, const T& value, WorkSignal& signal) {
+  const Queued<T> item{MonotonicNs(), value};
+  if (!deterministic_) {
+    if (queue.TryPush(item)) signal.Notify();
+    return;
+  }
+  // Deterministic: enqueue, then wait until the stage has consumed this very item.
+  const uint64_t target = queue.pushed() + 1;
+  while (!queue.TryPush(item)) std::this_thread::yield();
+  signal.Notify();
+  while (true) {
+    const uint32_t seen = consumed_signal_.sequence();
+    if (queue.popped() >= target) break;
+    consumed_signal_.WaitChange(seen);
+  }
+}
+
+void Pipeline::OnImu(const ImuSample& s) { Publish(imu_queue_, s, estimation_signal_); }
+void Pipeline::OnWheelOdometry(const WheelOdometrySample& s) { Publish(wheel_queue_, s, estimation_signal_); }
+void Pipeline::OnTrigger(const TriggerEvent& e) { Publish(trigger_queue_, e, estimation_signal_); }
+void Pipeline::OnStereo(const StereoFrame& f) { Publish(stereo_queue_, f, stereo_signal_); }
+
+void Pipeline::OnDeviceFault(const DeviceFault& fault) {
+  // Faults are rare and come from driver threads: a lock here never touches a real-time path.
+  {
+    std::lock_guard lock(fault_mutex_);
+    ++faults_.counts[fault.device][DeviceFaultKindName(fault.kind)];
+    ++faults_.total;
+    if (faults_.first_messages.size() < 20) {
+      faults_.first_messages.push_back(fault.device + ": " + DeviceFaultKindName(fault.kind) +
+                                       ": " + fault.detail);
+    }
+  }
+  spdlog::warn("device fault: {}: {}: {}", fault.device, DeviceFaultKindName(fault.kind), fault.detail);
+}
+
+void Pipeline::RequestFilterSwitch(const FilterSwitchRequest& request) {
+  Publish(switch_queue_, request, estimation_signal_);
+}
+
+void Pipeline::RequestFrameSwitch(const FrameSwitchRequest& request) {
+  // At the end of a run the filter has stopped: the last submap is finished without a switch.
+  if (!filter_running_.load(std::memory_order_acquire)) return;
+  ++mapping_switch_requests_;
+  RequestFilterSwitch(FilterSwitchRequest{request.time, request.reason == PartitionReason::kDistance
+                                                            ? FrameSwitchReason::kDistance
+                                                            : FrameSwitchReason::kPositionSigma});
+}
+
+void Pipeline::EstimationLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { estimation_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = estimation_signal_.sequence();
+    bool worked = false;
+    while (const std::optional<EstimationInput> next = estimation_inputs_.Next()) {
+      const int64_t now = MonotonicNs();
+      switch (*next) {
+        case EstimationInput::kImu: {
+          const Queued<ImuSample>& imu = *imu_queue_.Front();
+          const Duration latency = Duration::Nanoseconds(now - imu.enqueued_ns);
+          imu_latency_.Record(latency);
+          if (latency > imu_deadline_) deadline_misses_.fetch_add(1, std::memory_order_relaxed);
+          imu_stats_.Add(imu.value.time);
+          if (estimation_) estimation_->OnImu(imu.value);
+          if (telemetry_ != nullptr) telemetry_->OfferImu(imu.value);
+          // Live mode: wake mapping when an estimate it waits for came out (deterministic replays
+          // map at fixed points of the data flow instead, see MappingLoop).
+          if (mapping_ && !deterministic_ && mapping_estimate_queue_.pushed() != mapping_estimates_seen_) {
+            mapping_estimates_seen_ = mapping_estimate_queue_.pushed();
+            mapping_signal_.Notify();
+          }
+          imu_queue_.PopFront();
+          break;
+        }
+        case EstimationInput::kWheel: {
+          const Queued<WheelOdometrySample>& wheel = *wheel_queue_.Front();
+          wheel_latency_.Record(Duration::Nanoseconds(now - wheel.enqueued_ns));
+          wheel_stats_.Add(wheel.value.time);
+          if (estimation_) estimation_->OnWheel(wheel.value);
+          if (telemetry_ != nullptr) telemetry_->OfferWheelOdometry(wheel.value);
+          wheel_queue_.PopFront();
+          break;
+        }
+        case EstimationInput::kTrigger:
+          trigger_stats_.Add(trigger_queue_.Front()->value.time);
+          trigger_queue_.PopFront();
+          break;
+        case EstimationInput::kClone:
+          estimation_->OnFrame(clone_queue_.Front()->value);
+          clone_queue_.PopFront();
+          break;
+        case EstimationInput::kVoResult:
+          estimation_->OnVoResult(vo_result_queue_.Front()->value);
+          vo_result_queue_.PopFront();
+          break;
+        case EstimationInput::kFrameSwitch:
+          estimation_->OnFrameSwitch(switch_queue_.Front()->value);
+          switch_queue_.PopFront();
+          break;
+      }
+      worked = true;
+      if (deterministic_) consumed_signal_.Notify();
+      if (graph_ && graph_queue_.pushed() != graph_inputs_seen_) {
+        graph_inputs_seen_ = graph_queue_.pushed();
+        graph_signal_.Notify();
+      }
+    }
+    if (stop.stop_requested() && estimation_inputs_.empty()) return;
+    if (!worked) estimation_signal_.WaitChange(seen);
+  }
+}
+
+void Pipeline::StereoLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { stereo_signal_.Notify(); });
+  const MonotonicClock clock;
+  while (true) {
+    const uint32_t seen = stereo_signal_.sequence();
+    bool worked = false;
+    while (const auto* queued = stereo_queue_.Front()) {
+      stereo_latency_.Record(Duration::Nanoseconds(MonotonicNs() - queued->enqueued_ns));
+      const StereoFrame* f = &queued->value;
+      stereo_stats_.Add(f->time);
+      int gap = 0;
+      if (stereo_stats_.count() > 1 && f->frame_counter > last_frame_counter_ + 1) {
+        gap = static_cast<int>(std::min<uint64_t>(f->frame_counter - last_frame_counter_ - 1, 1 << 20));
+        stereo_report_.frame_counter_gaps += f->frame_counter - last_frame_counter_ - 1;
+      }
+      last_frame_counter_ = f->frame_counter;
+      if (f->left.width != stereo_report_.width || f->left.height != stereo_report_.height) {
+        if (stereo_stats_.count() > 1) ++stereo_report_.size_changes;
+        stereo_report_.width = f->left.width;
+        stereo_report_.height = f->left.height;
+      }
+      if (telemetry_ != nullptr) telemetry_->OfferStereo(*f);
+      if (estimation_) {
+        // The filter clones its state at the exposure time now; the odometry's delta pose
+        // references that clone when it arrives.
+        Publish(clone_queue_, f->time, estimation_signal_);
+        const Timestamp start = clock.Now();
+        RectifiedPair pair;
+        pending_dropped_ += gap;
+        if (rectify_->Rectify(*f, &pair)) {
+          rectify_time_.Record(clock.Now() - start);
+          pair.dropped_before = pending_dropped_;
+          pending_dropped_ = 0;
+          Publish(rectified_queue_, pair, vo_signal_);
+          if (mapping_ && dense_counter_++ % static_cast<uint64_t>(dense_every_) == 0) {
+            Publish(dense_queue_, pair, mapping_signal_);
+          }
+        } else {
+          ++rectify_failures_;
+        }
+      }
+      stereo_queue_.PopFront();
+      worked = true;
+      if (deterministic_) consumed_signal_.Notify();
+    }
+    if (stop.stop_requested() && stereo_queue_.empty()) return;
+    if (!worked) stereo_signal_.WaitChange(seen);
+  }
+}
+
+void Pipeline::DrainEstimates() {
+  while (const FrameEstimate* e = estimate_queue_.Front()) {
+    const std::optional<FilterSwitchRequest> request = vo_stage_->OnEstimate(*e);
+    if (e->valid && telemetry_ != nullptr) telemetry_->OfferPose(e->time, e->T_first_body);
+    estimate_queue_.PopFront();
+    if (request) RequestFilterSwitch(*request);
+  }
+}
+
+void Pipeline::VoLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { vo_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = vo_signal_.sequence();
+    bool worked = false;
+    while (const auto* queued = rectified_queue_.Front()) {
+      // The filter's estimates are taken in right before each frame (a fixed point in the data
+      // flow, so deterministic replays switch frames at the same instants).
+      DrainEstimates();
+      const VoResult r = vo_stage_->Process(queued->value);
+      Publish(vo_result_queue_, r, estimation_signal_);
+      rectified_queue_.PopFront();
+      worked = true;
+      if (deterministic_) consumed_signal_.Notify();
+    }
+    if (stop.stop_requested() && rectified_queue_.empty()) return;
+    if (!worked) vo_signal_.WaitChange(seen);
+  }
+}
+
+void Pipeline::TakeMappingInputs() {
+  while (const FrameEstimate* e = mapping_estimate_queue_.Front()) {
+    mapping_->OnEstimate(*e);
+    mapping_estimate_queue_.PopFront();
+  }
+  while (const FrameSwitchEvent* e = switch_event_queue_.Front()) {
+    mapping_->OnFrameSwitch(*e);
+    switch_event_queue_.PopFront();
+  }
+}
+
+void Pipeline::MappingLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { mapping_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = mapping_signal_.sequence();
+    bool worked = false;
+    if (!deterministic_) {
+      TakeMappingInputs();
+      mapping_->ProcessReady(/*final=*/false);
+    }
+    while (const auto* queued = dense_queue_.Front()) {
+      if (deterministic_) {
+        // A fixed point of the data flow: everything the filter says about the earlier pairs is
+        // in (the publisher is held until this pair is taken), so the images waiting for those
+        // estimates are mapped, and any frame switch requested, at the same instant every run.
+        TakeMappingInputs();
+        mapping_->ProcessReady(/*final=*/false);
+      }
+      const RectifiedPair pair = queued->value;  // holds the image buffers
+      dense_queue_.PopFront();
+      if (deterministic_) consumed_signal_.Notify();
+      mapping_->OnPair(pair);
+      if (!deterministic_) {
+        TakeMappingInputs();
+        mapping_->ProcessReady(/*final=*/false);
+      }
+      worked = true;
+    }
+    if (stop.stop_requested() && dense_queue_.empty()) return;
+    if (!worked) mapping_signal_.WaitChange(seen);
+  }
+}
+
+void Pipeline::GraphLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { graph_signal_.Notify(); });
+  while (true) {
+    const uint32_t seen = graph_signal_.sequence();
+    bool worked = false;
+    while (const GraphInput* in = graph_queue_.Front()) {
+      graph_->OnInput(*in);
+      graph_queue_.PopFront();
+      worked = true;
+    }
+    // The live view: at each new origin, else about once a second of data.
+    const bool new_origin = graph_->submap_origins() != graph_shown_origins_;
+    if (worked && telemetry_ != nullptr && telemetry_->live() &&
+        (new_origin || graph_->last_time() - graph_shown_time_ >= Duration::Seconds(1.0))) {
+      graph_shown_origins_ = graph_->submap_origins();
+      graph_shown_time_ = graph_->last_time();
+      telemetry_->PublishGraph(graph_shown_time_,
+                               graph_scene_.Encode(graph_shown_time_, graph_->robot(), graph_->Scene(new_origin)));
+    }
+    // The estimation thread has stopped before this is asked: its last inputs are in the queue.
+    if (stop.stop_requested() && graph_queue_.empty()) return;
+    if (!worked) graph_signal_.WaitChange(seen);
+  }
+}
+
+std::vector<QueueReport> Pipeline::queue_reports() const {
+  const auto r = [](const char* name, const auto& q) {
+    return QueueReport{name, q.capacity(), q.pushed(), q.dropped(), q.high_water()};
+  };
+  std::vector<QueueReport> out = {r("imu", imu_queue_), r("wheel_odometry", wheel_queue_),
+                                  r("trigger", trigger_queue_), r("stereo", stereo_queue_)};
+  if (estimation_) {
+    for (QueueReport q : {r("vo", rectified_queue_), r("clone", clone_queue_), r("vo_result", vo_result_queue_),
+                          r("frame_switch", switch_queue_), r("estimate", estimate_queue_)}) {
+      out.push_back(q);
+    }
+  }
+  if (mapping_) {
+    for (QueueReport q : {r("dense", dense_queue_), r("mapping_estimate", mapping_estimate_queue_),
+                          r("frame_switch_event", switch_event_queue_)}) {
+      out.push_back(q);
+    }
+  }
+  if (graph_) out.push_back(r("graph", graph_queue_));
+  return out;
+}
+
+uint64_t Pipeline::total_dropped() const {
+  return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
+         rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
+         estimate_queue_.dropped() + dense_queue_.dropped() + mapping_estimate_queue_.dropped() +
+         switch_event_queue_.dropped() + graph_queue_.dropped();
+}
+
+std::vector<LatencyReport> Pipeline::latency_reports() const {
+  const auto r = [](const char* name, const LatencyHistogram& h) {
+    return LatencyReport{name, h.count(), h.Quantile(0.5).seconds(), h.Quantile(0.99).seconds(), h.max().seconds()};
+  };
+  return {r("imu", imu_latency_), r("wheel_odometry", wheel_latency_), r("stereo", stereo_latency_)};
+}
+
+std::vector<ExecutorReport> Pipeline::executor_reports() const {
+  std::vector<ExecutorReport> out = {estimation_exec_.report(), stereo_.report()};
+  if (estimation_) out.push_back(vo_.report());
+  if (mapping_) out.push_back(mapping_exec_.report());
+  if (graph_) out.push_back(graph_exec_.report());
+  if (graph_ && !deterministic_) out.push_back(graph_full_solve_exec_.report());
+  return out;
+}
+
+std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
+  if (!vo_stage_) return {};
+  const auto r = [](const char* name, const LatencyHistogram& h) {
+    return StageTimingReport{name, h.count(), h.Quantile(0.5).seconds(), h.Quantile(0.99).seconds(), h.max().seconds()};
+  };
+  std::vector<StageTimingReport> out = {r("rectify", rectify_time_), r("vo", vo_stage_->vo_time())};
+  if (mapping_) {
+    out.push_back(r("dense_stereo", mapping_->match_time()));
+    out.push_back(r("mapping", mapping_->map_time()));
+  }
+  if (graph_) out.push_back(r("graph_update", graph_->update_time()));
+  return out;
+}
+
+EstimationReport Pipeline::estimation_report() const {
+  return estimation_ ? estimation_->report() : EstimationReport{};
+}
+
+FaultReport Pipeline::fault_report() const {
+  std::lock_guard lock(fault_mutex_);
+  return faults_;
+}
+
+}  // namespace cairn

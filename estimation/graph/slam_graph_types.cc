@@ -1,0 +1,36 @@
+#include "estimation/graph/slam_graph_types.h"
+
+#include "estimation/graph/pose_factors.h"
+
+namespace cairn {
+
+bool IsUnary(FactorKind kind) {
+  return kind == FactorKind::kPrior || kind == FactorKind::kAbsolutePose ||
+         kind == FactorKind::kAbsolutePosition;
+}
+
+bool IsRobustFactor(FactorKind kind) {
+  return kind == FactorKind::kDetection || kind == FactorKind::kLandmark || kind == FactorKind::kMatch ||
+         kind == FactorKind::kAbsolutePose || kind == FactorKind::kAbsolutePosition;
+}
+
+PoseGraphEdge EdgeOfFactor(const SlamFactor& f) {
+  PoseGraphEdge e;
+  e.from = f.a;
+  e.to = f.b;
+  e.T_from_to = f.z;
+  e.information = f.information;
+  PoseGraph::SetIsotropicWeights(e);
+  return e;
+}
+
+ceres::CostFunction* MakeFactorCostFunction(const SlamFactor& f) {
+  switch (f.kind) {
+    case FactorKind::kPrior:
+    case FactorKind::kAbsolutePose: return AbsolutePoseResidual::Create(f.z, f.information);
+    case FactorKind::kAbsolutePosition: return AbsolutePositionResidual::Create(f.position, f.position_information);
+    default: return RelativePoseResidual::Create(f.z, f.information);
+  }
+}
+
+}  // namespace cairn

@@ -1,0 +1,58 @@
+#pragma once
+// Variables and factors of the multi-robot SLAM graph (thesis 4.2), shared by the online graph and
+// the background batch solve.
+
+#include <cstdint>
+
+#include "estimation/graph/pose_graph.h"
+
+namespace ceres {
+class CostFunction;
+}  // namespace ceres
+
+namespace cairn {
+
+enum class VariableKind : uint8_t { kRobotPose = 'x', kSubmap = 's', kLandmark = 'l' };
+
+// Variable key: robot letter in the top byte (as the g2o multi-robot keys), kind in the next.
+constexpr uint64_t VariableKey(VariableKind kind, char robot, uint64_t index) {
+  return (static_cast<uint64_t>(static_cast<unsigned char>(robot)) << 56) |
+         (static_cast<uint64_t>(kind) << 48) | (index & ((uint64_t{1} << 48) - 1));
+}
+constexpr VariableKind KindOfKey(uint64_t key) { return static_cast<VariableKind>((key >> 48) & 0xff); }
+constexpr char RobotOfVariable(uint64_t key) { return static_cast<char>(key >> 56); }
+constexpr uint64_t IndexOfVariable(uint64_t key) { return key & ((uint64_t{1} << 48) - 1); }
+
+enum class FactorKind {
+  kPrior,             // unary, own robot's first submap
+  kFrameSwitch,       // w: s_i -> s_i+1
+  kFilterEstimate,    // v: s_j -> x
+  kOdometry,          // u: x_i -> x_i+1 (sequential topology)
+  kDetection,         // d: x^r0 -> x^r1
+  kLandmark,          // o: x -> l
+  kMatch,             // c: s -> s
+  kAbsolutePose,      // unary pose fix (known landmark, GNSS with heading)
+  kAbsolutePosition,  // unary position fix (GNSS)
+};
+
+struct SlamFactor {
+  FactorKind kind = FactorKind::kPrior;
+  uint64_t a = 0;     // first (or only) variable
+  uint64_t b = 0;     // second variable of binary factors
+  Pose3 z;            // measured pose of b in a (binary), of a in the world (unary pose)
+  Matrix6d information = Matrix6d::Identity();  // tx ty tz, rotation vector
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();               // kAbsolutePosition
+  Eigen::Matrix3d position_information = Eigen::Matrix3d::Identity();
+};
+
+bool IsUnary(FactorKind kind);
+// Factors that get the Cauchy loss (thesis 4.2.3: detections, landmarks, matches; also fixes).
+bool IsRobustFactor(FactorKind kind);
+
+// The g2o / PoseGraph edge of binary factor `f` (with its isotropic SE-Sync weights).
+PoseGraphEdge EdgeOfFactor(const SlamFactor& f);
+
+// The residual of `f` (geodesic relative / absolute pose, or absolute position); caller owns it.
+ceres::CostFunction* MakeFactorCostFunction(const SlamFactor& f);
+
+}  // namespace cairn

@@ -1,0 +1,180 @@
+#include "sim/sim_robot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "sim/sim_random.h"
+#include "sim/tag36h11_code.h"
+
+namespace cairn::sim {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kKnot = 0.5;  // s between spline control points
+
+// Camera looking along body x, pitched down by `tilt` (camera: z forward, x right, y down).
+Eigen::Matrix3d ForwardCamera(double tilt) {
+  Eigen::Matrix3d base;
+  base.col(0) = -Eigen::Vector3d::UnitY();
+  base.col(1) = -Eigen::Vector3d::UnitZ();
+  base.col(2) = Eigen::Vector3d::UnitX();
+  return base * Eigen::AngleAxisd(-tilt, Eigen::Vector3d::UnitX()).toRotationMatrix();
+}
+
+StereoCalibration MakeStereo(int width, int height, double f, double baseline, double scale,
+                             const Eigen::Vector3d& p_body_left, const Eigen::Matrix3d& R_body_cam) {
+  StereoCalibration s;
+  PinholeRadTan k;
+  k.width = static_cast<int>(std::lround(width * scale));
+  k.height = static_cast<int>(std::lround(height * scale));
+  k.fx = k.fy = f * scale;
+  k.cx = (k.width - 1) / 2.0;
+  k.cy = (k.height - 1) / 2.0;
+  s.left.name = "cam0";
+  s.right.name = "cam1";
+  s.left.intrinsics = s.right.intrinsics = k;
+  s.left.T_body_cam.linear() = R_body_cam;
+  s.left.T_body_cam.translation() = p_body_left;
+  s.right.T_body_cam = s.left.T_body_cam * Eigen::Translation3d(baseline, 0, 0);
+  return s;
+}
+
+// Xsens MTi-10 class figures: gyro 0.03 deg/s/sqrt(Hz), accel 60 ug/sqrt(Hz); bias random walks
+// chosen for an in-run stability of roughly 18 deg/h and 15 ug.
+ImuCalibration XsensMti10(double rate_hz) {
+  ImuCalibration c;
+  c.rate_hz = rate_hz;
+  c.gyro_noise_density = 0.03 * kPi / 180.0;
+  c.accel_noise_density = 60e-6 * 9.81;
+  c.gyro_random_walk = 2.0e-5;
+  c.accel_random_walk = 1.0e-4;
+  return c;
+}
+
+// Angle difference wrapped into (-pi, pi].
+double Wrap(double a) { return std::remainder(a, 2 * kPi); }
+
+std::vector<Eigen::Vector3d> UnwrapYaw(std::vector<Eigen::Vector3d> e) {
+  for (size_t i = 1; i < e.size(); ++i) e[i][0] = e[i - 1][0] + Wrap(e[i][0] - e[i - 1][0]);
+  return e;
+}
+
+}  // namespace
+
+SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
+                   double duration, double image_scale, double tag_size) {
+  SimRobot r;
+  r.name = name;
+  r.kind = SimRobotKind::kRover;
+  r.stereo = MakeStereo(1024, 508, 1080.0, 0.09, image_scale, {0.2, 0.045, 1.0}, ForwardCamera(25 * kPi / 180));
+  r.imu = XsensMti10(200.0);
+  r.wheels = {{0.35, 0.33, -0.3}, {0.35, -0.33, -0.3}, {-0.35, 0.33, -0.3}, {-0.35, -0.33, -0.3}};
+  // Seeded loop: a wobbly circle, driven at 0.4 m/s.
+  SimRandom rng = SimRandom::Stream(seed, 100 + static_cast<uint64_t>(index));
+  const double limit = terrain.half_size() - 3.0;
+  const double R0 = std::min(7.0, limit / 2), phase = rng.Uniform(0, 2 * kPi);
+  // y before x: a seed names one world whatever order a compiler evaluates arguments in (this is
+  // the order GCC's builds always drew, so earlier missions keep their paths).
+  const double center_y = rng.Uniform(-3, 3);
+  const double center_x = rng.Uniform(-3, 3);
+  const Eigen::Vector2d center(std::clamp(center_x + 4.0 * index, -limit + R0, limit - R0),
+                               std::clamp(center_y, -limit + R0, limit - R0));
+  const double speed = 0.4, wobble = 0.15;
+  auto xy_at = [&](double s) {
+    const double th = phase + s / R0;
+    const double rad = R0 * (1 + wobble * std::sin(2 * th + phase));
+    return Eigen::Vector2d(center + rad * Eigen::Vector2d(std::cos(th), std::sin(th)));
+  };
+  const int n = static_cast<int>(std::ceil(duration / kKnot)) + 4;
+  std::vector<Eigen::Vector3d> pos, euler;
+  // It stands still before it drives off, as a rover does until its estimator has initialized
+  // (wheels turning hold the filter's static initialization back).
+  const double still = 2.0;  // s
+  for (int i = 0; i < n; ++i) {
+    const double s = speed * std::max(0.0, kKnot * (i - 1) - still);
+    const Eigen::Vector2d p = xy_at(s), ahead = xy_at(s + 0.05) - xy_at(s - 0.05);
+    const double yaw = std::atan2(ahead.y(), ahead.x());
+    const Eigen::Rotation2Dd R(yaw);
+    double hw[4];
+    for (size_t w = 0; w < 4; ++w) {
+      const Eigen::Vector2d pw = p + R * r.wheels[w].head<2>();
+      hw[w] = terrain.Height(pw.x(), pw.y());
+    }
+    // Wheels: 0 front-left, 1 front-right, 2 rear-left, 3 rear-right.
+    const double pitch = std::atan2((hw[2] + hw[3]) - (hw[0] + hw[1]), 2 * 0.7);
+    const double roll = std::atan2((hw[0] + hw[2]) - (hw[1] + hw[3]), 2 * 0.66);
+    pos.emplace_back(p.x(), p.y(), (hw[0] + hw[1] + hw[2] + hw[3]) / 4 + 0.3);
+    euler.emplace_back(yaw, pitch, roll);
+  }
+  r.trajectory = BSplineTrajectory(kKnot, std::move(pos), UnwrapYaw(std::move(euler)));
+  // Body and camera mast, and three tags tilted 40 deg upwards around the mast.
+  r.boxes.push_back({Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.0)), {0.45, 0.35, 0.15}, 0.35f});
+  r.boxes.push_back({Eigen::Isometry3d(Eigen::Translation3d(0.2, 0, 0.55)), {0.05, 0.05, 0.4}, 0.3f});
+  for (int k = 0; k < 3; ++k) {
+    SimMarker m;
+    m.id = 10 * index + k;
+    m.size = tag_size;
+    m.bits = *Tag36h11MarkerBits(m.id);
+    const double az = kPi + 2 * kPi * k / 3;  // first tag faces backwards
+    const Eigen::Matrix3d R_face =
+        (Eigen::AngleAxisd(az, Eigen::Vector3d::UnitZ()) *
+         Eigen::AngleAxisd(kPi / 2 - 40 * kPi / 180, Eigen::Vector3d::UnitY()))
+            .toRotationMatrix();  // marker z = outward normal, raised 40 deg
+    m.T_body_marker.linear() = R_face;
+    m.T_body_marker.translation() = Eigen::Vector3d(0.2, 0, 0.75) + 0.12 * (R_face * Eigen::Vector3d::UnitZ());
+    r.markers.push_back(m);
+  }
+  return r;
+}
+
+SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
+                        double duration, double image_scale, double tag_size) {
+  SimRobot r;
+  r.name = name;
+  r.kind = SimRobotKind::kHexacopter;
+  r.stereo = MakeStereo(666, 506, 350.0, 0.12, image_scale, {0.15, 0.06, -0.05}, ForwardCamera(60 * kPi / 180));
+  r.imu = XsensMti10(400.0);
+  SimRandom rng = SimRandom::Stream(seed, 200 + static_cast<uint64_t>(index));
+  const double limit = terrain.half_size() - 3.0;
+  const double R0 = std::min(9.0, limit / 2), phase = rng.Uniform(0, 2 * kPi);
+  const double speed = 1.0, altitude = rng.Uniform(3.5, 5.0);
+  const int n = static_cast<int>(std::ceil(duration / kKnot)) + 4;
+  std::vector<Eigen::Vector3d> pos, euler;
+  // It hovers after take-off before it sets out, as a survey flight does (and as the filter's static
+  // initialization needs: a multicopter in flight is never still).
+  const double hover = 2.0;  // s
+  const auto th_at = [&](int i) { return phase + speed * std::max(0.0, kKnot * (i - 1) - hover) / R0; };
+  for (int i = 0; i < n; ++i) {
+    const double th = th_at(i);
+    const Eigen::Vector2d p = R0 * Eigen::Vector2d(std::cos(th), 0.6 * std::sin(2 * th) + std::sin(th) * 0.4);
+    double ground = terrain.Height(p.x(), p.y());
+    pos.emplace_back(p.x(), p.y(), ground + altitude + 0.5 * std::sin(3 * th));
+  }
+  // Heading along the path; roll and pitch lean into the horizontal acceleration as a multirotor.
+  for (int i = 0; i < n; ++i) {
+    const size_t a = static_cast<size_t>(std::max(i - 1, 0)), b = static_cast<size_t>(std::min(i + 1, n - 1));
+    const Eigen::Vector3d vel = (pos[b] - pos[a]) / (kKnot * static_cast<double>(b - a));
+    const Eigen::Vector3d acc = i > 0 && i < n - 1
+                                    ? Eigen::Vector3d((pos[b] - 2 * pos[static_cast<size_t>(i)] + pos[a]) / (kKnot * kKnot))
+                                    : Eigen::Vector3d::Zero();
+    // Hovering, it already faces along the path (its tangent at the start).
+    const double th = th_at(i);
+    const Eigen::Vector2d tangent(-std::sin(th), 1.2 * std::cos(2 * th) + 0.4 * std::cos(th));
+    const double yaw = vel.head<2>().norm() > 1e-6 ? std::atan2(vel.y(), vel.x()) : std::atan2(tangent.y(), tangent.x());
+    const Eigen::Vector2d acc_body = Eigen::Rotation2Dd(-yaw) * acc.head<2>();
+    euler.emplace_back(yaw, std::atan2(acc_body.x(), 9.81), -std::atan2(acc_body.y(), 9.81));
+  }
+  r.trajectory = BSplineTrajectory(kKnot, std::move(pos), UnwrapYaw(std::move(euler)));
+  r.boxes.push_back({Eigen::Isometry3d::Identity(), {0.3, 0.3, 0.06}, 0.25f});
+  SimMarker m;
+  m.id = 100 + index;
+  m.size = tag_size;
+  m.bits = *Tag36h11MarkerBits(m.id);
+  m.T_body_marker.linear() = Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitX()).toRotationMatrix();  // faces down
+  m.T_body_marker.translation() = Eigen::Vector3d(0, 0, -0.065);
+  r.markers.push_back(m);
+  return r;
+}
+
+}  // namespace cairn::sim

@@ -1,0 +1,55 @@
+#pragma once
+// One simulated robot: its sensors' true calibration, its C2 trajectory through the world and the
+// geometry other robots' cameras see (body boxes and AprilTag-style markers).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "hal/calibration.h"
+#include "sim/bspline_trajectory.h"
+#include "sim/terrain.h"
+
+namespace cairn::sim {
+
+enum class SimRobotKind { kRover, kHexacopter };
+
+// A square fiducial: 10 x 10 modules (white quiet ring, black border ring, 6 x 6 data bits),
+// `size` is the edge of the black border square. z of the marker frame points out of the face.
+struct SimMarker {
+  int id = 0;  // tag36h11 id
+  double size = 0.16;
+  uint64_t bits = 0;  // 36 data bits, row-major from the marker's top-left
+  Eigen::Isometry3d T_body_marker = Eigen::Isometry3d::Identity();
+};
+
+struct SimBox {
+  Eigen::Isometry3d T_body_box = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d half_extent = Eigen::Vector3d::Constant(0.1);
+  float albedo = 0.3f;
+};
+
+struct SimRobot {
+  std::string name;
+  SimRobotKind kind = SimRobotKind::kRover;
+  StereoCalibration stereo;     // T_body_cam: body frame = IMU frame
+  ImuCalibration imu;
+  double camera_rate_hz = 10.0;
+  BSplineTrajectory trajectory;
+  std::vector<SimMarker> markers;
+  std::vector<SimBox> boxes;
+  // Wheel contact points in the body frame (rover only).
+  std::vector<Eigen::Vector3d> wheels;
+};
+
+// LRU-like rover (1024 x 508, f = 1080 px, b = 0.09 m; MTi-10 IMU) driving a seeded loop.
+// `image_scale` shrinks the cameras (tests); `index` separates robots of one mission.
+SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
+                   double duration, double image_scale, double tag_size);
+// Ardea-like hexacopter: stereo pair (666 x 506, b = 0.12 m) pitched 60 deg down, 400 Hz IMU.
+SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
+                        double duration, double image_scale, double tag_size);
+
+}  // namespace cairn::sim

@@ -1,0 +1,40 @@
+#pragma once
+// One simulated robot as a live sensor source inside cairnd: IMU samples, rendered stereo pairs
+// and wheel odometry decoded from its simulated CAN frames (through the same CanWheelDecoder the
+// SocketCAN driver uses) are published in timestamp order, IMU first on ties, paced in real time,
+// scaled, or as fast as the sink takes them. Images are rendered when they fall due.
+
+#include <atomic>
+#include <memory>
+#include <thread>
+
+#include "drivers/replay/replay_clock.h"
+#include "drivers/replay/replay_options.h"
+#include "hal/sensor_source_interface.h"
+#include "sim/mission_simulator.h"
+
+namespace cairn::sim {
+
+class SimulatorSource final : public SensorSourceInterface {
+ public:
+  // `pacing`/`speed` as for a replay (ReplayOptions' dataset and deterministic are unused).
+  SimulatorSource(std::shared_ptr<const MissionSimulator> simulator, size_t robot, ReplayOptions pacing);
+  ~SimulatorSource() override;
+
+  std::string name() const override { return "sim/" + simulator_->robots()[robot_].name; }
+  Status Start(SensorSink* sink) override;
+  void Stop() override;
+  bool finished() const override { return finished_.load(std::memory_order_acquire); }
+
+ private:
+  void Run(std::stop_token stop);
+
+  std::shared_ptr<const MissionSimulator> simulator_;
+  size_t robot_;
+  ReplayClock clock_;
+  SensorSink* sink_ = nullptr;
+  std::jthread thread_;
+  std::atomic<bool> finished_{false};
+};
+
+}  // namespace cairn::sim

@@ -1,0 +1,225 @@
+#include "sim/terrain_generator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "sim/sim_random.h"
+
+namespace cairn::sim {
+namespace {
+
+// Lattice value in [-1, 1] for integer coordinates of one noise layer.
+inline double LatticeValue(uint64_t seed, int64_t ix, int64_t iy, uint64_t layer) {
+  const uint64_t h = SimRandom::Mix(seed ^ SimRandom::Mix(static_cast<uint64_t>(ix) * 0x9E3779B97F4A7C15ull ^
+                                                          static_cast<uint64_t>(iy) * 0xC2B2AE3D27D4EB4Full ^
+                                                          layer * 0x165667B19E3779F9ull));
+  return static_cast<double>(h >> 11) * 0x1.0p-52 - 1.0;
+}
+
+// Fractal sum of value noise (quintic fade, wavelength 1 in lattice units) from `wavelength` down by
+// halves, amplitudes falling with `gain`, sampled on a grid (x = i * step - half for column i, y
+// likewise for row j), one row at a time with the rows in increasing order. Every octave's lattice
+// values are computed once per lattice point: each octave caches the two lattice rows around the
+// current grid row.
+class FbmRows {
+ public:
+  FbmRows(uint64_t seed, int count, double step, double half, double wavelength, int octaves, double gain,
+          uint64_t layer)
+      : seed_(seed), count_(count), step_(step), half_(half) {
+    double amp = 1.0;
+    for (int k = 0; k < octaves; ++k) {
+      Octave o;
+      o.wavelength = wavelength;
+      o.amp = amp;
+      o.layer = layer * 64 + static_cast<uint64_t>(k);
+      // Per column: the lattice column left of the sample and the fade weight towards the right.
+      o.column.resize(static_cast<size_t>(count));
+      o.fade.resize(static_cast<size_t>(count));
+      for (int i = 0; i < count; ++i) {
+        const double x = (i * step - half) / wavelength;
+        const double fx = std::floor(x);
+        const double u = x - fx;
+        o.column[static_cast<size_t>(i)] = static_cast<int64_t>(fx);
+        o.fade[static_cast<size_t>(i)] = u * u * u * (u * (u * 6 - 15) + 10);
+      }
+      o.first_column = o.column.front();
+      const size_t span = static_cast<size_t>(o.column.back() - o.first_column + 2);
+      o.row0.resize(span);
+      o.row1.resize(span);
+      norm_ += amp;
+      amp *= gain;
+      wavelength *= 0.5;
+      octaves_.push_back(std::move(o));
+    }
+  }
+
+  void Row(int j, double* out) {
+    std::fill(out, out + count_, 0.0);
+    for (Octave& o : octaves_) {
+      const double y = (j * step_ - half_) / o.wavelength;
+      const double fy = std::floor(y);
+      const int64_t iy = static_cast<int64_t>(fy);
+      const double v = y - fy;
+      const double sv = v * v * v * (v * (v * 6 - 15) + 10);
+      if (iy != o.cached_row) {
+        for (size_t c = 0; c < o.row0.size(); ++c) {
+          const int64_t ix = o.first_column + static_cast<int64_t>(c);
+          o.row0[c] = LatticeValue(seed_, ix, iy, o.layer);
+          o.row1[c] = LatticeValue(seed_, ix, iy + 1, o.layer);
+        }
+        o.cached_row = iy;
+      }
+      for (int i = 0; i < count_; ++i) {
+        const size_t c = static_cast<size_t>(o.column[static_cast<size_t>(i)] - o.first_column);
+        const double su = o.fade[static_cast<size_t>(i)];
+        const double a = o.row0[c], b = o.row0[c + 1], cc = o.row1[c], d = o.row1[c + 1];
+        out[i] += o.amp * ((a + (b - a) * su) * (1 - sv) + (cc + (d - cc) * su) * sv);
+      }
+    }
+    for (int i = 0; i < count_; ++i) out[i] /= norm_;
+  }
+
+ private:
+  struct Octave {
+    double wavelength = 0.0, amp = 0.0;
+    uint64_t layer = 0;
+    std::vector<int64_t> column;
+    std::vector<double> fade;
+    int64_t first_column = 0;
+    int64_t cached_row = std::numeric_limits<int64_t>::min();
+    std::vector<double> row0, row1;
+  };
+  uint64_t seed_;
+  int count_;
+  double step_, half_, norm_ = 0.0;
+  std::vector<Octave> octaves_;
+};
+
+// Adds `profile(distance / radius)` to every vertex within `reach * radius` of (cx, cy).
+template <class Profile>
+void Stamp(std::vector<float>& h, int n, double half, double res, double cx, double cy,
+           double radius, double reach, Profile profile) {
+  const double r = radius * reach;
+  const int x0 = std::max(0, static_cast<int>(std::floor((cx - r + half) / res)));
+  const int x1 = std::min(n - 1, static_cast<int>(std::ceil((cx + r + half) / res)));
+  const int y0 = std::max(0, static_cast<int>(std::floor((cy - r + half) / res)));
+  const int y1 = std::min(n - 1, static_cast<int>(std::ceil((cy + r + half) / res)));
+  for (int iy = y0; iy <= y1; ++iy) {
+    for (int ix = x0; ix <= x1; ++ix) {
+      const double dx = ix * res - half - cx, dy = iy * res - half - cy;
+      const double s = std::sqrt(dx * dx + dy * dy) / radius;
+      if (s < reach) h[static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix)] += static_cast<float>(profile(s));
+    }
+  }
+}
+
+}  // namespace
+
+TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
+  TerrainGrids t;
+  t.half_size = o.size / 2;
+  t.resolution = o.resolution;
+  t.n = static_cast<int>(std::lround(o.size / o.resolution)) + 1;
+  const uint64_t seed = static_cast<uint64_t>(o.seed);
+  const int n = t.n;
+  const double half = t.half_size, res = t.resolution;
+  t.heights.assign(static_cast<size_t>(n) * static_cast<size_t>(n), 0.0f);
+
+  // Rolling ground: wavelengths from 24 m down to ~0.4 m.
+  {
+    FbmRows ground(seed, n, res, half, 24.0, 7, 0.45, 1);
+    std::vector<double> row(static_cast<size_t>(n));
+    for (int iy = 0; iy < n; ++iy) {
+      ground.Row(iy, row.data());
+      for (int ix = 0; ix < n; ++ix) {
+        t.heights[static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix)] =
+            static_cast<float>(o.relief * row[static_cast<size_t>(ix)]);
+      }
+    }
+  }
+  SimRandom rng = SimRandom::Stream(seed, 17);
+  const double hectares = o.size * o.size / 1e4;
+  // Small craters: bowl with a raised rim, more small ones than large ones.
+  const int craters = static_cast<int>(std::lround(o.crater_density * hectares));
+  for (int i = 0; i < craters; ++i) {
+    const double cx = rng.Uniform(-half, half), cy = rng.Uniform(-half, half);
+    const double r = 0.5 * std::pow(8.0, rng.Uniform() * rng.Uniform());
+    const double depth = 0.18 * r, rim = 0.05 * r;
+    Stamp(t.heights, n, half, res, cx, cy, r, 2.0, [&](double s) {
+      return s < 1.0 ? depth * (s * s - 1.0) + rim * s * s * s * s : rim * std::exp(-(s - 1.0) * (s - 1.0) / 0.08);
+    });
+  }
+  // One large crater with steep inner walls: a cliff-like negative edge for the classifier.
+  if (o.big_crater) {
+    const double r = std::min(10.0, o.size / 6);
+    const double cx = rng.Uniform(-half / 2, half / 2), cy = rng.Uniform(-half / 2, half / 2);
+    const double depth = 0.3 * r, rim = 0.08 * r;
+    Stamp(t.heights, n, half, res, cx, cy, r, 1.8, [&](double s) {
+      const double s8 = std::pow(s, 8.0);
+      return s < 1.0 ? depth * (s8 - 1.0) + rim * s8 : rim * std::exp(-(s - 1.0) * (s - 1.0) / 0.05);
+    });
+  }
+  // Boulders: hemispheroids standing on the ground (positive steps).
+  std::vector<Eigen::Vector4d> rocks;
+  const int rock_count = static_cast<int>(std::lround(o.rock_density * hectares));
+  for (int i = 0; i < rock_count; ++i) {
+    const double cx = rng.Uniform(-half, half), cy = rng.Uniform(-half, half);
+    const double r = 0.05 * std::pow(10.0, rng.Uniform() * rng.Uniform());
+    const double hr = r * rng.Uniform(0.5, 0.9);
+    rocks.emplace_back(cx, cy, r, hr);
+    Stamp(t.heights, n, half, res, cx, cy, r, 1.0, [&](double s) { return hr * std::sqrt(std::max(0.0, 1.0 - s * s)); });
+  }
+  BuildAlbedo(o, rocks, &t);
+  return t;
+}
+
+void TerrainGenerator::BuildAlbedo(const WorldOptions& o, const std::vector<Eigen::Vector4d>& rocks,
+                                   TerrainGrids* t) {
+  const uint64_t seed = static_cast<uint64_t>(o.seed);
+  const double half_size = t->half_size;
+  const double tex_res = t->resolution / 4;
+  const int tex_n = static_cast<int>(std::lround(2 * half_size / tex_res)) + 1;
+  t->texture_resolution = tex_res;
+  t->texture_n = tex_n;
+  std::vector<float> a(static_cast<size_t>(tex_n) * static_cast<size_t>(tex_n));
+  // Large patches (regolith colour) and fine grains, with most energy at stereo-relevant scales.
+  FbmRows coarse_rows(seed, tex_n, tex_res, half_size, 8.0, 4, 0.6, 2);
+  FbmRows fine_rows(seed, tex_n, tex_res, half_size, 0.4, 4, 0.7, 3);
+  std::vector<double> coarse(static_cast<size_t>(tex_n)), fine(static_cast<size_t>(tex_n));
+  for (int iy = 0; iy < tex_n; ++iy) {
+    coarse_rows.Row(iy, coarse.data());
+    fine_rows.Row(iy, fine.data());
+    for (int ix = 0; ix < tex_n; ++ix) {
+      const size_t i = static_cast<size_t>(ix);
+      a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n) + i] =
+          static_cast<float>(0.5 + o.albedo_contrast * (0.5 * coarse[i] + 0.9 * fine[i]));
+    }
+  }
+  // Rocks are darker than the regolith around them.
+  for (const Eigen::Vector4d& r : rocks) {
+    const int x0 = std::max(0, static_cast<int>((r[0] - r[2] + half_size) / tex_res));
+    const int x1 = std::min(tex_n - 1, static_cast<int>((r[0] + r[2] + half_size) / tex_res) + 1);
+    const int y0 = std::max(0, static_cast<int>((r[1] - r[2] + half_size) / tex_res));
+    const int y1 = std::min(tex_n - 1, static_cast<int>((r[1] + r[2] + half_size) / tex_res) + 1);
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) {
+        const double dx = ix * tex_res - half_size - r[0], dy = iy * tex_res - half_size - r[1];
+        if (dx * dx + dy * dy < r[2] * r[2]) a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n) + static_cast<size_t>(ix)] *= 0.75f;
+      }
+    }
+  }
+  t->grain.resize(256 * 256);
+  for (size_t i = 0; i < t->grain.size(); ++i) {
+    t->grain[i] = static_cast<float>(LatticeValue(seed, static_cast<int64_t>(i & 255), static_cast<int64_t>(i >> 8), 9));
+  }
+  t->albedo.resize(a.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    t->albedo[i] = static_cast<uint8_t>(std::clamp(std::lround(a[i] * 255.0f), 0l, 255l));
+  }
+}
+
+}  // namespace cairn::sim

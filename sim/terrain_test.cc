@@ -1,0 +1,173 @@
+#include "sim/terrain.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "sim/sim_random.h"
+
+namespace cairn::sim {
+namespace {
+
+WorldOptions SmallWorld() {
+  WorldOptions w;
+  w.size = 20.0;
+  w.seed = 7;
+  w.lander.clear();
+  return w;
+}
+
+// A point of the central 16 m square at z = 0, drawn y first (GCC's argument order), the same on
+// every compiler.
+Eigen::Vector3d RandomGroundPoint(SimRandom& rng) {
+  const double y = rng.Uniform(-8, 8);
+  const double x = rng.Uniform(-8, 8);
+  return {x, y, 0.0};
+}
+
+TEST(TerrainTest, SameSeedSameTerrainOtherSeedOtherTerrain) {
+  const Terrain a = Terrain::Generate(SmallWorld()), b = Terrain::Generate(SmallWorld());
+  WorldOptions o = SmallWorld();
+  o.seed = 8;
+  const Terrain c = Terrain::Generate(o);
+  int differ = 0;
+  for (double x = -9; x < 9; x += 0.37) {
+    for (double y = -9; y < 9; y += 0.41) {
+      ASSERT_EQ(a.Height(x, y), b.Height(x, y));
+      ASSERT_EQ(a.Albedo(x, y), b.Albedo(x, y));
+      differ += a.Height(x, y) != c.Height(x, y);
+    }
+  }
+  EXPECT_GT(differ, 100);
+}
+
+TEST(TerrainTest, RocksAddSteepStepsToTheGround) {
+  WorldOptions smooth = SmallWorld();
+  smooth.rock_density = 0.0;
+  smooth.crater_density = 0.0;
+  smooth.big_crater = false;
+  WorldOptions rocky = smooth;
+  rocky.rock_density = 3000.0;
+  auto max_slope = [](const Terrain& t) {
+    double m = 0.0;
+    for (double x = -9.5; x < 9.5; x += 0.05) {
+      for (double y = -9.5; y < 9.5; y += 0.05) m = std::max(m, 1.0 / t.Normal(x, y).z());
+    }
+    return m;
+  };
+  const double s0 = max_slope(Terrain::Generate(smooth)), s1 = max_slope(Terrain::Generate(rocky));
+  EXPECT_LT(s0, 1.5);  // rolling ground: below ~48 deg
+  EXPECT_GT(s1, 2.0);  // rock flanks: steeper than 60 deg
+}
+
+// The max-mipmap traversal must return the first intersection: the hit lies on the surface and
+// no sample before it along the ray is below the surface.
+TEST(TerrainTest, RaycastFindsTheFirstSurfaceHit) {
+  const Terrain t = Terrain::Generate(SmallWorld());
+  SimRandom rng(3);
+  int hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Eigen::Vector3d o = RandomGroundPoint(rng);
+    const Eigen::Vector3d origin(o.x(), o.y(), t.Height(o.x(), o.y()) + rng.Uniform(0.3, 4.0));
+    // From grazing (1 deg below the horizon) to steep.
+    const double el = -rng.Uniform(0.017, 1.4), az = rng.Uniform(0, 6.283);
+    const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    const TerrainHit hit = t.Raycast(origin, d, 40.0);
+    const double end = hit.t > 0 ? hit.t : 40.0;
+    for (double s = 0.0; s < end - 1e-3; s += 0.002) {
+      const Eigen::Vector3d p = origin + s * d;
+      if (std::abs(p.x()) > 10 || std::abs(p.y()) > 10) break;
+      ASSERT_GT(p.z(), t.Height(p.x(), p.y()) - 1e-6) << "ray " << i << " passes below ground at " << s;
+    }
+    if (hit.t > 0) {
+      ++hits;
+      const Eigen::Vector3d p = origin + hit.t * d;
+      EXPECT_NEAR(p.z(), t.Height(p.x(), p.y()), 1e-6) << "ray " << i;
+      EXPECT_NEAR(hit.normal.dot(t.Normal(p.x(), p.y())), 1.0, 1e-3) << "ray " << i;
+    }
+  }
+  EXPECT_GT(hits, 300);
+}
+
+// A start distance the ray is clear up to changes nothing about the hit.
+TEST(TerrainTest, RaycastFromAClearDistanceFindsTheSameHit) {
+  const Terrain t = Terrain::Generate(SmallWorld());
+  SimRandom rng(5);
+  int hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Eigen::Vector3d o = RandomGroundPoint(rng);
+    const Eigen::Vector3d origin(o.x(), o.y(), t.Height(o.x(), o.y()) + rng.Uniform(0.3, 4.0));
+    const double el = -rng.Uniform(0.017, 1.4), az = rng.Uniform(0, 6.283);
+    const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    const TerrainHit full = t.Raycast(origin, d, 40.0);
+    if (full.t <= 0) continue;
+    ++hits;
+    for (const double f : {0.0, 0.3, 0.9, 0.999}) {
+      const TerrainHit from = t.Raycast(origin, d, 40.0, f * full.t);
+      ASSERT_NEAR(from.t, full.t, 1e-12 * full.t) << "ray " << i << " from " << f;
+      EXPECT_NEAR(from.normal.dot(full.normal), 1.0, 1e-9);
+    }
+  }
+  EXPECT_GT(hits, 300);
+}
+
+// Every ray of a bundle (unit directions within `spread` of the central one) is clear of the
+// terrain up to the bundle's clear distance, and the distance is not trivially short.
+TEST(TerrainTest, ClearDistanceBoundsEveryRayOfTheBundle) {
+  const Terrain t = Terrain::Generate(SmallWorld());
+  SimRandom rng(11);
+  double gained = 0.0;
+  int bundles = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d o = RandomGroundPoint(rng);
+    const Eigen::Vector3d origin(o.x(), o.y(), t.Height(o.x(), o.y()) + rng.Uniform(0.3, 4.0));
+    const double el = -rng.Uniform(0.05, 1.4), az = rng.Uniform(0, 6.283);
+    const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    const double spread = rng.Uniform(0.0, 0.02);
+    const double clear = t.ClearDistance(origin, d, spread, 40.0);
+    ASSERT_GE(clear, 0.0);
+    for (int k = 0; k < 20; ++k) {
+      // A direction at chord distance <= spread from d (the unit sphere's cap around it).
+      const double jz = rng.Uniform(-1, 1), jy = rng.Uniform(-1, 1), jx = rng.Uniform(-1, 1);
+      const Eigen::Vector3d jitter(jx, jy, jz);
+      Eigen::Vector3d e = (d + 0.5 * spread * jitter).normalized();
+      if ((e - d).norm() > spread) e = d;
+      const TerrainHit hit = t.Raycast(origin, e, 40.0);
+      if (hit.t > 0) {
+        ASSERT_GE(hit.t, clear) << "bundle " << i << " ray " << k;
+      }
+    }
+    const TerrainHit centre = t.Raycast(origin, d, 40.0);
+    if (centre.t > 0) {
+      gained += clear / centre.t;
+      ++bundles;
+    }
+  }
+  ASSERT_GT(bundles, 200);
+  EXPECT_GT(gained / bundles, 0.5);  // on average the bound reaches more than half way
+}
+
+// max_slope bounds the height difference of any two points by their distance.
+TEST(TerrainTest, MaxSlopeBoundsTheSurface) {
+  const Terrain t = Terrain::Generate(SmallWorld());
+  SimRandom rng(13);
+  double steepest = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = rng.Uniform(-9.5, 9.5), y = rng.Uniform(-9.5, 9.5);
+    const double a = rng.Uniform(0, 6.283), r = rng.Uniform(0.001, 0.3);
+    const double x2 = x + r * std::cos(a), y2 = y + r * std::sin(a);
+    const double s = std::abs(t.Height(x2, y2) - t.Height(x, y)) / std::hypot(x2 - x, y2 - y);
+    ASSERT_LE(s, t.max_slope());
+    steepest = std::max(steepest, s);
+  }
+  EXPECT_GT(steepest, 0.5 * t.max_slope());
+}
+
+TEST(TerrainTest, RaysUpIntoTheSkyMiss) {
+  const Terrain t = Terrain::Generate(SmallWorld());
+  EXPECT_LT(t.Raycast({0, 0, t.Height(0, 0) + 1.0}, Eigen::Vector3d(1, 0, 1).normalized(), 100).t, 0.0);
+  EXPECT_LT(t.Raycast({50, 0, 5.0}, Eigen::Vector3d(1, 0, -0.1).normalized(), 100).t, 0.0);
+}
+
+}  // namespace
+}  // namespace cairn::sim

@@ -1,0 +1,54 @@
+#pragma once
+// The simulated world as described by a small YAML file (`cairn sim --world`). Everything is
+// derived from these numbers and the seed, so a world file plus a seed reproduces a mission.
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "common/options_visitor.h"
+
+namespace cairn::sim {
+
+struct WorldOptions {
+  double size = 60.0;             // side of the square world, centred on the origin
+  double resolution = 0.1;        // height-grid spacing
+  int64_t seed = 1;
+  double relief = 1.2;            // amplitude of the multi-octave height field
+  double crater_density = 40.0;   // craters per hectare (radius 0.5-4 m)
+  double rock_density = 600.0;    // boulders per hectare (radius 0.05-0.5 m)
+  bool big_crater = true;         // one large crater with a steep rim (cliff-like negative edge)
+  double sun_azimuth = 135.0;     // from +x towards +y
+  double sun_elevation = 35.0;
+  double albedo_contrast = 0.35;  // relative albedo variation of the texture
+  // Optional static landmark tags (e.g. on a lander): x, y of the lander, 0 or 2 values.
+  std::vector<double> lander = {6.0, -4.0};
+  double tag_size = 0.16;         // edge of the tags' black border square
+
+  void Visit(OptionsVisitor& v) {
+    v.Number("size", size, 10.0, 400.0, "m");
+    v.Number("resolution", resolution, 0.02, 1.0, "m");
+    v.Integer("seed", seed, 0, int64_t{1} << 62, "");
+    v.Number("relief", relief, 0.0, 20.0, "m");
+    v.Number("crater_density", crater_density, 0.0, 2000.0, "1/ha");
+    v.Number("rock_density", rock_density, 0.0, 20000.0, "1/ha");
+    v.Flag("big_crater", big_crater);
+    v.Number("sun_azimuth", sun_azimuth, -360.0, 360.0, "deg");
+    v.Number("sun_elevation", sun_elevation, 5.0, 90.0, "deg");
+    v.Number("albedo_contrast", albedo_contrast, 0.0, 0.9, "");
+    v.Numbers("lander", lander, 0, 2, -200.0, 200.0, "m");
+    v.Number("tag_size", tag_size, 0.02, 2.0, "m");
+  }
+  Status Validate() const {
+    if (size / resolution > 8000.0) {
+      return InvalidArgumentError("size / resolution exceeds 8000 cells per side (memory)");
+    }
+    if (lander.size() == 1) return InvalidArgumentError("lander needs x and y (or nothing)");
+    if (lander.size() == 2 && (std::abs(lander[0]) > size / 2 - 2 || std::abs(lander[1]) > size / 2 - 2)) {
+      return InvalidArgumentError("lander must lie at least 2 m inside the world");
+    }
+    return Status::Ok();
+  }
+};
+
+}  // namespace cairn::sim

@@ -1,0 +1,44 @@
+#pragma once
+// Scores a disparity map against ground truth the way the Middlebury and KITTI benchmarks do:
+// a pixel with ground truth is bad when its estimate is missing or off by more than the threshold
+// (KITTI D1: more than 3 px and more than 5 % of the true disparity).
+
+#include <string>
+
+#include "common/status.h"
+#include "stereo/pfm_io.h"
+
+namespace cairn {
+
+enum class DisparityMetric { kBad05, kBad1, kBad2, kBad4, kD1 };
+
+Expected<DisparityMetric> ParseDisparityMetric(const std::string& name);
+const char* DisparityMetricName(DisparityMetric metric);
+
+struct DisparityScore {
+  double bad_nonocc = 0.0;  // fraction of scored non-occluded pixels that are bad
+  double bad_all = 0.0;     // fraction of all pixels with ground truth that are bad
+  double density = 0.0;     // fraction of image pixels with an estimate
+  long scored_nonocc = 0;
+  long scored_all = 0;
+  bool mask_derived = false;  // non-occluded mask computed from the ground truth itself
+};
+
+// Ground truth: PFM (inf or NaN = unknown) or PNG (0 = unknown; value / scale). scale <= 0
+// picks 256 for 16-bit PNG (KITTI) and 1 for 8-bit PNG.
+Expected<FloatImage> LoadGroundTruth(const std::string& path, double scale);
+
+// Non-occluded mask: 255 where the pixel is visible in both views. `mask` may be empty: then a
+// left pixel counts as occluded when its ground truth lands outside the right image or behind a
+// nearer ground-truth pixel there.
+class DisparityEvaluator {
+ public:
+  static Expected<DisparityScore> Score(const FloatImage& estimate, const FloatImage& truth,
+                                        const FloatImage& mask, DisparityMetric metric);
+  static FloatImage DeriveNonOccludedMask(const FloatImage& truth);
+};
+
+// Reads a Middlebury mask PNG (255 non-occluded, 128 occluded, 0 unknown) into a FloatImage.
+Expected<FloatImage> LoadMask(const std::string& path);
+
+}  // namespace cairn

@@ -1,0 +1,148 @@
+#include "stereo/disparity_evaluator.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "stereo/pfm_io.h"
+#include "stereo/stereo_image_io.h"
+
+namespace cairn {
+namespace {
+
+const float kInf = std::numeric_limits<float>::infinity();
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("cairn_fpga_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
+TEST(PfmIoTest, RoundTripKeepsValuesRowOrderAndInfinity) {
+  FloatImage img{3, 2, {1.5f, 2.25f, kInf, -4.0f, 0.0f, 1e6f}};
+  const std::string path = TempPath("rt.pfm");
+  ASSERT_TRUE(WritePfm(path, img).ok());
+  auto back = ReadPfm(path);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ(back->width, 3);
+  EXPECT_EQ(back->height, 2);
+  EXPECT_EQ(back->data, img.data);
+  // Middlebury stores the bottom row first.
+  std::ifstream f(path, std::ios::binary);
+  std::string header((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  ASSERT_GE(header.size(), 12u);
+  EXPECT_EQ(header.rfind("Pf\n3 2\n-1", 0), 0u);
+  float first;
+  std::memcpy(&first, header.data() + header.size() - 24, 4);
+  EXPECT_EQ(first, -4.0f);
+  std::filesystem::remove(path);
+}
+
+TEST(PfmIoTest, ReportsBadFiles) {
+  EXPECT_EQ(ReadPfm(TempPath("missing.pfm")).status().code(), StatusCode::kNotFound);
+  const std::string path = TempPath("bad.pfm");
+  {
+    std::ofstream f(path);
+    f << "P6\n2 2\n255\n";
+  }
+  EXPECT_EQ(ReadPfm(path).status().code(), StatusCode::kDataLoss);
+  {
+    std::ofstream f(path, std::ios::binary);
+    f << "Pf\n4 4\n-1.0\n" << "abcd";  // 4 of 64 bytes
+  }
+  EXPECT_EQ(ReadPfm(path).status().code(), StatusCode::kDataLoss);
+  EXPECT_FALSE(WritePfm(path, FloatImage{2, 2, {1.0f}}).ok());
+  EXPECT_FALSE(WritePfm("/nonexistent-dir/x.pfm", FloatImage{1, 1, {1.0f}}).ok());
+  std::filesystem::remove(path);
+}
+
+TEST(DisparityEvaluatorTest, CountsBadAndMissingPixels) {
+  // Ground truth 10 everywhere except one unknown pixel; mask marks one pixel occluded.
+  FloatImage truth{4, 1, {10.0f, 10.0f, 10.0f, kInf}};
+  FloatImage estimate{4, 1, {10.4f, 12.0f, kInf, 3.0f}};
+  FloatImage mask{4, 1, {255.0f, 255.0f, 128.0f, 255.0f}};
+  auto s = DisparityEvaluator::Score(estimate, truth, mask, DisparityMetric::kBad1);
+  ASSERT_TRUE(s.ok());
+  EXPECT_EQ(s->scored_nonocc, 2);
+  EXPECT_EQ(s->scored_all, 3);
+  EXPECT_DOUBLE_EQ(s->bad_nonocc, 0.5);      // 12 is off by 2
+  EXPECT_DOUBLE_EQ(s->bad_all, 2.0 / 3.0);   // and the missing estimate counts as bad
+  EXPECT_DOUBLE_EQ(s->density, 0.75);
+  s = DisparityEvaluator::Score(estimate, truth, mask, DisparityMetric::kBad4);
+  EXPECT_DOUBLE_EQ(s->bad_nonocc, 0.0);
+  // KITTI D1 needs both 3 px and 5 %.
+  FloatImage far_truth{2, 1, {100.0f, 20.0f}};
+  FloatImage far_est{2, 1, {104.0f, 23.5f}};
+  s = DisparityEvaluator::Score(far_est, far_truth, FloatImage{}, DisparityMetric::kD1);
+  ASSERT_TRUE(s.ok());
+  EXPECT_DOUBLE_EQ(s->bad_all, 0.5);
+}
+
+TEST(DisparityEvaluatorTest, RejectsSizeMismatchAndUnknownMetric) {
+  FloatImage a{2, 2, {1, 1, 1, 1}}, b{2, 1, {1, 1}};
+  EXPECT_FALSE(DisparityEvaluator::Score(a, b, FloatImage{}, DisparityMetric::kBad1).ok());
+  EXPECT_FALSE(DisparityEvaluator::Score(a, a, b, DisparityMetric::kBad1).ok());
+  EXPECT_FALSE(ParseDisparityMetric("bad3").ok());
+  EXPECT_TRUE(ParseDisparityMetric("d1").ok());
+}
+
+TEST(DisparityEvaluatorTest, DerivedMaskMarksPixelsHiddenBehindNearerOnes) {
+  // Background disparity 2, a near object (disparity 6) at columns 6..7: background columns
+  // 2..5 land on right columns 0..3 and columns 6..7 land on 0..1 too, so 2..3 are hidden.
+  FloatImage truth{10, 1, {2, 2, 2, 2, 2, 2, 6, 6, 2, 2}};
+  const FloatImage mask = DisparityEvaluator::DeriveNonOccludedMask(truth);
+  EXPECT_EQ(mask.data[0], 128.0f);  // lands outside the right image
+  EXPECT_EQ(mask.data[2], 128.0f);
+  EXPECT_EQ(mask.data[3], 128.0f);
+  EXPECT_EQ(mask.data[4], 255.0f);
+  EXPECT_EQ(mask.data[6], 255.0f);
+  EXPECT_EQ(mask.data[9], 255.0f);
+}
+
+TEST(DisparityEvaluatorTest, LoadsScaledPngGroundTruth) {
+  const std::string p8 = TempPath("gt8.png"), p16 = TempPath("gt16.png");
+  cv::Mat g8(1, 3, CV_8UC1);
+  g8.at<uint8_t>(0, 0) = 0;
+  g8.at<uint8_t>(0, 1) = 40;
+  g8.at<uint8_t>(0, 2) = 255;
+  ASSERT_TRUE(cv::imwrite(p8, g8));
+  auto gt = LoadGroundTruth(p8, 4.0);
+  ASSERT_TRUE(gt.ok());
+  EXPECT_TRUE(std::isinf(gt->data[0]));
+  EXPECT_FLOAT_EQ(gt->data[1], 10.0f);
+  cv::Mat g16(1, 2, CV_16UC1);
+  g16.at<uint16_t>(0, 0) = 256 * 30 + 128;
+  g16.at<uint16_t>(0, 1) = 0;
+  ASSERT_TRUE(cv::imwrite(p16, g16));
+  gt = LoadGroundTruth(p16, 0.0);  // KITTI default scale 256
+  ASSERT_TRUE(gt.ok());
+  EXPECT_FLOAT_EQ(gt->data[0], 30.5f);
+  EXPECT_TRUE(std::isinf(gt->data[1]));
+  EXPECT_EQ(LoadGroundTruth(TempPath("none.png"), 1.0).status().code(), StatusCode::kNotFound);
+  std::filesystem::remove(p8);
+  std::filesystem::remove(p16);
+}
+
+TEST(StereoImageIoTest, ReportsUnreadableAndMismatchedPairs) {
+  const std::string a = TempPath("a.png"), b = TempPath("b.png");
+  ASSERT_TRUE(cv::imwrite(a, cv::Mat(10, 12, CV_8UC3, cv::Scalar(1, 2, 3))));
+  ASSERT_TRUE(cv::imwrite(b, cv::Mat(10, 13, CV_8UC1, cv::Scalar(5))));
+  auto ok = LoadGrayPair(a, a);
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(ok->left.type(), CV_8UC1);  // colour converted to gray
+  auto mismatch = LoadGrayPair(a, b);
+  EXPECT_EQ(mismatch.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(mismatch.status().message().find("13x10"), std::string::npos);
+  EXPECT_EQ(LoadGrayPair(TempPath("nope.png"), a).status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(LoadGrayPair(a, TempPath("nope.png")).status().code(), StatusCode::kNotFound);
+  std::filesystem::remove(a);
+  std::filesystem::remove(b);
+}
+
+}  // namespace
+}  // namespace cairn
