@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "drivers/replay/euroc_dataset.h"
-#include "sim/testing/rover_can_layout.h"
+#include "sim/rover_can_layout.h"
 #include "sim/world_file.h"
 #include "tests/support/test_data.h"
 
@@ -30,9 +30,7 @@ MissionOptions ShortMission() {
   m.robots = {"rover", "hexacopter"};
   m.duration = 0.6;
   m.image_scale = 0.1;
-  auto layout = testing::LoadRoverCanLayout();
-  EXPECT_TRUE(layout.ok()) << layout.status().ToString();
-  if (layout.ok()) m.can = *layout;
+  m.can = RoverCanLayout();
   return m;
 }
 

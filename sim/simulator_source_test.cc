@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "sim/testing/rover_can_layout.h"
+#include "sim/rover_can_layout.h"
 #include "tests/support/recording_sink.h"
 #include "tests/support/test_data.h"
 
@@ -21,9 +21,7 @@ std::shared_ptr<const MissionSimulator> ShortMission() {
   m.duration = 0.5;
   m.image_scale = 0.1;
   m.render_threads = 2;  // as cairnd renders (and so under ThreadSanitizer too)
-  auto layout = testing::LoadRoverCanLayout();
-  EXPECT_TRUE(layout.ok()) << layout.status().ToString();
-  if (layout.ok()) m.can = *layout;
+  m.can = RoverCanLayout();
   auto sim = MissionSimulator::Create(w, m);
   EXPECT_TRUE(sim.ok());
   return std::shared_ptr<const MissionSimulator>(std::move(*sim));

@@ -22,7 +22,6 @@ Terrain::Terrain(TerrainGrids grids)
       h_(std::move(grids.heights)),
       grain_(std::move(grids.grain)),
       tex_n_(grids.texture_n),
-      tex_res_(grids.texture_resolution),
       inv_tex_res_(1.0 / grids.texture_resolution),
       albedo_(std::move(grids.albedo)) {
   BuildMaxMipmap();

@@ -118,7 +118,6 @@ class Terrain {
   static constexpr int kStartLevel = 4;
   static constexpr int kNearCells = 24;  // single-cell steps before a started ray uses the pyramid
   int tex_n_ = 0;
-  double tex_res_ = 0.0;
   double inv_tex_res_ = 0.0;
   std::vector<uint8_t> albedo_;
 };

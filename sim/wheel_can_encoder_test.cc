@@ -6,9 +6,8 @@
 
 #include "drivers/can_wheel_decoder.h"
 #include "sim/candump_format.h"
+#include "sim/rover_can_layout.h"
 #include "sim/sim_robot.h"
-#include "sim/testing/rover_can_layout.h"
-#include "tests/support/test_data.h"
 
 namespace cairn::sim {
 namespace {
@@ -16,9 +15,7 @@ namespace {
 // The rover profile's CAN layout, frames through candump text, back through the decoder that the
 // SocketCAN driver uses: the decoded wheel states are the simulated ones up to quantization.
 TEST(WheelCanEncoderTest, CandumpFramesDecodeToTheSimulatedWheelStates) {
-  auto loaded = testing::LoadRoverCanLayout();
-  ASSERT_TRUE(loaded.ok()) << loaded.status().ToString();
-  const CanWheelOptions& layout = *loaded;
+  const CanWheelOptions layout = RoverCanLayout();
   WorldOptions w;
   w.size = 30.0;
   w.resolution = 0.2;

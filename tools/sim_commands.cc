@@ -15,6 +15,7 @@
 
 #include "daemon/cairnd_config.h"
 #include "sim/mission_simulator.h"
+#include "sim/rover_can_layout.h"
 #include "sim/world_file.h"
 #include "tools/commands.h"
 
@@ -27,7 +28,7 @@ constexpr const char* kSimUsage =
     "                 --out DIR\n"
     "  --motion-blur:  average N instants over each exposure (default 1: off)\n"
     "  --rover-config: cairnd profile whose 'can:' section gives the wheel CAN layout\n"
-    "                  (default configs/rover.yaml, else /etc/cairn/rover.yaml)\n";
+    "                  (default: the simulated rover's built-in layout, as in configs/rover.yaml)\n";
 
 std::vector<std::string> SplitComma(const std::string& s) {
   std::vector<std::string> out;
@@ -70,22 +71,12 @@ class ProgressBar {
   int last_ = -1;
 };
 
-Expected<CanWheelOptions> LoadCanLayout(const std::string& requested) {
-  std::vector<std::string> candidates;
-  if (!requested.empty()) {
-    candidates = {requested};
-  } else {
-    candidates = {"configs/rover.yaml", "/etc/cairn/rover.yaml"};
-  }
-  for (const std::string& path : candidates) {
-    if (!requested.empty() || std::filesystem::exists(path)) {
-      auto options = LoadCairndOptions(path, {});
-      if (!options.ok()) return options.status();
-      return options->can;
-    }
-  }
-  return NotFoundError("no rover profile for the CAN layout (tried configs/rover.yaml and "
-                       "/etc/cairn/rover.yaml); pass --rover-config FILE");
+// The built-in layout of the simulated rover, or the `can:` section of a given cairnd profile.
+Expected<CanWheelOptions> LoadCanLayout(const std::string& profile) {
+  if (profile.empty()) return sim::RoverCanLayout();
+  auto options = LoadCairndOptions(profile, {});
+  if (!options.ok()) return options.status();
+  return options->can;
 }
 
 }  // namespace

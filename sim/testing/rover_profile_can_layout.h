@@ -1,6 +1,6 @@
 #pragma once
-// The rover profile's wheel CAN layout (`can:` in configs/rover.yaml), for simulator tests that
-// encode and decode wheel frames as the rover does, without loading the whole daemon profile.
+// The rover profile's wheel CAN layout (`can:` in configs/rover.yaml), read without loading the whole
+// daemon profile, for the test that holds the simulator's built-in layout to it.
 
 #include <string>
 
@@ -11,7 +11,7 @@
 
 namespace cairn::testing {
 
-inline Expected<CanWheelOptions> LoadRoverCanLayout() {
+inline Expected<CanWheelOptions> LoadRoverProfileCanLayout() {
   const std::string path = SourceDir() + "/configs/rover.yaml";
   auto doc = LoadYamlWithOverrides(path, {});
   if (!doc.ok()) return doc.status();
