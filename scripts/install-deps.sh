@@ -9,7 +9,7 @@ packages=(
   # the sanitizer builds (CI) use Clang and lld
   clang-14 lld-14 libclang-rt-14-dev
   # libraries
-  libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev
+  libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   # recording (MCAP chunks) and the live Foxglove stream
   libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev nodejs
