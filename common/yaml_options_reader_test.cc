@@ -1,5 +1,7 @@
 #include "common/yaml_options_reader.h"
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 
@@ -124,9 +126,14 @@ TEST(YamlOptionsReaderTest, WriterOutputReadsBackToTheSameOptions) {
 class OverrideTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    path_ = (std::filesystem::temp_directory_path() / "cairn_override_test.yaml").string();
+    // One file per test and process: ctest runs the tests of this fixture in parallel.
+    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    path_ = (std::filesystem::temp_directory_path() /
+             ("cairn_override_test_" + name + "_" + std::to_string(getpid()) + ".yaml"))
+                .string();
     std::ofstream(path_) << kGood;
   }
+  void TearDown() override { std::filesystem::remove(path_); }
   std::string path_;
 };
 
