@@ -485,7 +485,12 @@ Expected<std::vector<Matrix6d>> SlamGraph::Covariances(const std::vector<uint64_
     ++covariance_computations_;
     for (uint64_t key : stale) {
       const int i = covariance->IndexOf(variables_.at(key).block.get());
-      covariance_cache_[key] = {*Pose(key), i < 0 ? Matrix6d::Zero() : covariance->Marginal(i)};  // gauge: 0
+      // Ceres' quaternion tangent is half the rotation vector: scale the rotation rows and
+      // columns by 2 so callers get radians.
+      Matrix6d c = i < 0 ? Matrix6d::Zero() : covariance->Marginal(i);  // gauge: 0
+      c.bottomRows<3>() *= 2.0;
+      c.rightCols<3>() *= 2.0;
+      covariance_cache_[key] = {*Pose(key), c};
     }
     covariance_factor_count_ = factors_.size();
   }

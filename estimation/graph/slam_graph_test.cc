@@ -130,6 +130,33 @@ TEST(SlamGraphTest, GlobalPoseAndPositionFix) {
   EXPECT_FALSE(g.GlobalPose('c', Pose3()).ok());
 }
 
+// Covariances are in radians for the rotation: a chain of three switches, each 0.01 rad (1 sigma)
+// in yaw, leaves the last origin 0.01 * sqrt(3) rad unsure about its yaw.
+TEST(SlamGraphTest, CovarianceOfAChainAddsUpInRadians) {
+  SlamGraph g;
+  SlamFactor prior;
+  prior.kind = FactorKind::kPrior;
+  prior.a = VariableKey(VariableKind::kSubmap, 'a', 0);
+  prior.information = Matrix6d::Identity() * 1e12;
+  ASSERT_TRUE(g.AddFactor(prior).ok());
+  Matrix6d switch_covariance = Matrix6d::Identity() * 1e-2;
+  switch_covariance(5, 5) = 1e-4;
+  for (uint64_t k = 0; k < 3; ++k) {
+    SlamFactor w;
+    w.kind = FactorKind::kFrameSwitch;
+    w.a = VariableKey(VariableKind::kSubmap, 'a', k);
+    w.b = VariableKey(VariableKind::kSubmap, 'a', k + 1);
+    w.z = P(1, 0, 0, 0);
+    w.information = switch_covariance.inverse();
+    ASSERT_TRUE(g.AddFactor(w).ok());
+  }
+  g.SolveFull();
+  auto cov = g.Covariances({VariableKey(VariableKind::kSubmap, 'a', 3)});
+  ASSERT_TRUE(cov.ok()) << cov.status().message();
+  EXPECT_NEAR((*cov)[0](5, 5), 3e-4, 1e-9);
+  EXPECT_NEAR((*cov)[0](0, 0), 3e-2, 1e-8);
+}
+
 // Dense reference: H = J^T J from central differences of every whitened residual in the tangent
 // space, inverted; the marginal of a variable is its diagonal block.
 TEST(SlamGraphTest, CovariancesMatchADenseReference) {
@@ -181,7 +208,10 @@ TEST(SlamGraphTest, CovariancesMatchADenseReference) {
   auto cov = g.Covariances(keys);
   ASSERT_TRUE(cov.ok()) << cov.status().message();
   for (size_t i = 0; i < keys.size(); ++i) {
-    const Matrix6d ref = C.block<6, 6>(column[keys[i]], column[keys[i]]);
+    // The manifold's rotation tangent is half the rotation vector.
+    Matrix6d ref = C.block<6, 6>(column[keys[i]], column[keys[i]]);
+    ref.bottomRows<3>() *= 2.0;
+    ref.rightCols<3>() *= 2.0;
     EXPECT_LT(((*cov)[i] - ref).norm(), 1e-4 * ref.norm()) << keys[i];
   }
   // Cached until the graph changes.
