@@ -11,6 +11,7 @@
 #include "common/options_yaml_writer.h"
 #include "daemon/pipeline/pipeline.h"
 #include "daemon/run_summary.h"
+#include "daemon/submap_index.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "drivers/can_wheel_decoder.h"
@@ -165,6 +166,12 @@ int Cairnd::Run() {
       if (Status s = pipeline.EnableMapping(mapping); !s.ok()) {
         spdlog::error("{}: {}", config_path_, s.ToString());
         return 1;
+      }
+      if (options_.matching.enabled) {
+        if (Status s = pipeline.EnableMatching(options_.matching, options_.robot.name); !s.ok()) {
+          spdlog::error("{}: {}", config_path_, s.ToString());
+          return 1;
+        }
       }
     }
   }
@@ -327,6 +334,14 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
     if (options_.graph.write_g2o) {
       CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/graph.g2o", FormatG2o(graph->ExportPoseGraph())));
     }
+  }
+  if (const SubmapMatchingStage* matching = pipeline.matching(); matching != nullptr && options_.matching.write_csv) {
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/matches.csv", matching->FormatCsv()));
+  }
+  if (pipeline.mapping_enabled() && options_.mapping.write_submaps) {
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(
+        dir + "/submaps/index.csv",
+        FormatSubmapIndex(options_.robot.name, pipeline.submap_origin_times(), ground_truth_ ? &*ground_truth_ : nullptr)));
   }
   // Last: its presence means the run's outputs are complete.
   return WriteFileAtomically(dir + "/summary.json", BuildSummaryJson(run, pipeline));

@@ -11,6 +11,7 @@
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/executor_options.h"
 #include "daemon/pipeline/graph_stage_options.h"
+#include "daemon/pipeline/submap_matching_options.h"
 #include "daemon/pipeline/mapping_stage_options.h"
 #include "daemon/telemetry/live_stream_options.h"
 #include "daemon/telemetry/recording_options.h"
@@ -108,6 +109,7 @@ struct CairndOptions {
   DenseStereoOptions stereo;
   MappingStageOptions mapping;
   GraphStageOptions graph;
+  SubmapMatchingOptions matching;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -128,6 +130,7 @@ struct CairndOptions {
     v.Section("stereo", stereo);
     v.Section("mapping", mapping);
     v.Section("graph", graph);
+    v.Section("matching", matching);
   }
 };
 

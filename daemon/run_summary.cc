@@ -167,6 +167,19 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.EndArray();
     j.EndObject();
   }
+  if (const SubmapMatchingStage* matching = p.matching()) {
+    const SubmapMatchingReport m = matching->report();
+    j.Key("matching").BeginObject();
+    j.Field("submaps", m.submaps).Field("suitable", m.suitable);
+    j.Field("attempts", m.attempts).Field("matched", m.matched).Field("accepted", m.accepted);
+    j.Key("pairs").BeginObject();
+    for (const auto& [why, count] : m.pairs) j.Field(why, count);
+    j.EndObject();
+    j.Key("first_errors").BeginArray();
+    for (const auto& e : m.errors) j.String(e);
+    j.EndArray();
+    j.EndObject();
+  }
   const FaultReport f = p.fault_report();
   j.Key("faults").BeginObject();
   j.Field("total", f.total);
@@ -233,6 +246,15 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
     j.EndObject();
   }
   j.EndArray();
+  if (const SubmapMatchingStage* matching = p.matching()) {
+    // The matcher pool: how long its work took and how far it fell behind.
+    const SubmapMatchingReport m = matching->report();
+    j.Key("matcher_pool").BeginObject();
+    j.Field("jobs_waiting_max", m.jobs_waiting_max);
+    j.Field("features_ms_p50", m.features_ms_p50).Field("features_ms_max", m.features_ms_max);
+    j.Field("match_ms_p50", m.match_ms_p50).Field("match_ms_max", m.match_ms_max);
+    j.EndObject();
+  }
   j.Key("queues").BeginArray();
   for (const QueueReport& q : p.queue_reports()) {
     j.BeginObject();

@@ -21,6 +21,8 @@ packages=(
   libapriltag-dev
   # tools used by tests and scripts
   systemd iproute2 can-utils util-linux file python3
+  # tests: the real laser scan of ../shared/data/octomap is bzip2-compressed
+  libbz2-dev
   # dense stereo (fpga/): Google Highway SIMD
   libhwy-dev
   # FPGA offload (fpga/rtl): cosimulation and synthesis check

@@ -57,7 +57,9 @@ std::string ReadBytes(const std::string& path) {
 std::vector<std::string> SubmapFiles(const std::string& out) {
   std::vector<std::string> files;
   if (!fs::exists(out + "/submaps")) return files;
-  for (const auto& e : fs::directory_iterator(out + "/submaps")) files.push_back(e.path().string());
+  for (const auto& e : fs::directory_iterator(out + "/submaps")) {
+    if (e.path().extension() == ".submap") files.push_back(e.path().string());
+  }
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -105,6 +107,18 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
     bytes += fs::file_size(f);
   }
   EXPECT_EQ(bytes, m["submaps"]["bytes"].number());
+  // index.csv: a header and one row per submap, each with its origin's true pose (simulated run).
+  std::ifstream index(out + "/a/submaps/index.csv");
+  std::string row;
+  ASSERT_TRUE(std::getline(index, row)) << "no submaps/index.csv";
+  const auto header_commas = std::count(row.begin(), row.end(), ',');
+  size_t rows = 0;
+  while (std::getline(index, row)) {
+    ++rows;
+    EXPECT_EQ(std::count(row.begin(), row.end(), ','), header_commas) << row;
+    EXPECT_EQ(row.find(",,"), std::string::npos) << "a true pose is missing: " << row;
+  }
+  EXPECT_GE(rows, files.size());
 
   // The composed map: readable exports, and on the simulator's terrain.
   auto cloud = MapExporter::ReadCloud(out + "/a/map.ply");

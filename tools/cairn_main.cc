@@ -29,6 +29,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"bench sim", "time rendering a stereo pair of the simulator's default world", RunBenchSim},
     {"map", "submap files: info, export (PCD/PLY, .bt/.ot), compose", RunMap},
     {"bench map", "time local mapping (classification, submap integration, wire size, composition)", RunBenchMap},
+    {"match", "match two submap files (4-DoF: keypoints, descriptors, RANSAC, ICP) and print T_a_b as JSON", RunMatch},
+    {"bench match", "time submap matching on cairnd runs' submaps; recall and precision against the simulator", RunBenchMatch},
     {"eval", "trajectory accuracy vs ground truth (TUM/EuRoC): ATE, RPE, drift as JSON", RunEval},
     {"bench vo", "visual-odometry time per stereo frame on an EuRoC/ASL folder (no SGM)", RunBenchVo},
 });

@@ -40,5 +40,7 @@ int RunMap(const CommandArgs& args);
 int RunBenchMap(const CommandArgs& args);
 int RunEval(const CommandArgs& args);
 int RunBenchVo(const CommandArgs& args);
+int RunMatch(const CommandArgs& args);
+int RunBenchMatch(const CommandArgs& args);
 
 }  // namespace cairn::tools

@@ -45,6 +45,8 @@ struct ExecutorsOptions {
   ExecutorOptions graph;       // the SLAM graph's online optimization (low priority)
   // The graph's full solves after loop closures, live only (replays solve inline, deterministic).
   ExecutorOptions graph_full_solve;
+  // The submap matcher pool's workers (matching.workers of them), the lowest priority.
+  ExecutorOptions matcher;
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
@@ -54,6 +56,7 @@ struct ExecutorsOptions {
     v.Section("telemetry", telemetry);
     v.Section("graph", graph);
     v.Section("graph_full_solve", graph_full_solve);
+    v.Section("matcher", matcher);
   }
 };
 
@@ -70,6 +73,8 @@ struct QueueOptions {
   int64_t telemetry = 64;
   // Filter estimates and frame switches waiting for the graph (about 400 s of frames at 10 Hz).
   int64_t graph = 4096;
+  // Finished submaps waiting for the matcher.
+  int64_t submaps = 64;
 
   void Visit(OptionsVisitor& v) {
     v.Integer("imu", imu, 2, 1 << 20, "samples");
@@ -79,6 +84,7 @@ struct QueueOptions {
     v.Integer("dense", dense, 2, 1024, "frames");
     v.Integer("telemetry", telemetry, 2, 1 << 20, "samples");
     v.Integer("graph", graph, 2, 1 << 20, "items");
+    v.Integer("submaps", submaps, 2, 1 << 16, "submaps");
   }
 };
 

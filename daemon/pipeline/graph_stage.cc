@@ -1,5 +1,8 @@
 #include "daemon/pipeline/graph_stage.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "common/monotonic_clock.h"
 
 namespace cairn {
@@ -140,6 +143,64 @@ void GraphStage::Finish() {
   report_.final_cost = stats.cost;
   report_.chi2 = graph_.Chi2();
   report_.unconnected_variables = graph_.Unconnected().size();
+}
+
+Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTransform& T_a_b,
+                            const Eigen::Matrix4d& covariance, double tilt_sigma) {
+  if (!graph_.HasVariable(OriginKey(frame_a)) || !graph_.HasVariable(OriginKey(frame_b)))
+    return NotFoundError("match between origins " + std::to_string(frame_a) + " and " + std::to_string(frame_b) +
+                         ": not both in the graph");
+  // (x, y, z, yaw) into the factor's (translation, rotation vector); yaw is the rotation about z.
+  Matrix6d c = Matrix6d::Zero();
+  const int index[4] = {0, 1, 2, 5};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) c(index[i], index[j]) = covariance(i, j);
+  c(3, 3) = c(4, 4) = tilt_sigma * tilt_sigma;
+  SlamFactor f;
+  f.kind = FactorKind::kMatch;
+  f.a = OriginKey(frame_a);
+  f.b = OriginKey(frame_b);
+  f.z = ToPose3(T_a_b.ToIsometry());
+  f.information = Floored(c).inverse();
+  const size_t rejected = report_.rejected_factors;
+  if (!Add(f)) return InvalidArgumentError(report_.errors.empty() || report_.rejected_factors == rejected
+                                               ? "the graph refused the match"
+                                               : report_.errors.back());
+  ++report_.matches;
+  Update();
+  return Status::Ok();
+}
+
+std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
+  std::vector<OriginEstimate> out;
+  std::vector<uint64_t> keys;
+  const std::vector<uint64_t> unconnected = graph_.Unconnected();
+  for (uint64_t key : graph_.VariableKeys()) {
+    if (KindOfKey(key) != VariableKind::kSubmap || RobotOfVariable(key) != robot_) continue;
+    const auto p = graph_.Pose(key);
+    if (!p.ok()) continue;
+    OriginEstimate o;
+    o.frame_id = IndexOfVariable(key);
+    const Eigen::Matrix3d R = p->R();
+    o.T_global_origin = FourDofTransform(p->t, std::atan2(R(1, 0), R(0, 0)));
+    o.connected = std::find(unconnected.begin(), unconnected.end(), key) == unconnected.end();
+    out.push_back(o);
+    keys.push_back(key);
+  }
+  if (covariances && !keys.empty()) {
+    auto cov = graph_.Covariances(keys);
+    if (cov.ok()) {
+      const int index[4] = {0, 1, 2, 5};
+      for (size_t k = 0; k < keys.size(); ++k) {
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) out[k].covariance(i, j) = (*cov)[k](index[i], index[j]);
+        out[k].has_covariance = out[k].covariance.allFinite();
+      }
+    } else {
+      Error("covariances for submap pairing: " + cov.status().ToString());
+    }
+  }
+  return out;
 }
 
 GraphStageReport GraphStage::report() const { return report_; }

@@ -21,6 +21,7 @@
 #include "estimation/eval/trajectory.h"
 #include "estimation/graph/pose_graph.h"
 #include "estimation/graph/slam_graph.h"
+#include "mapping/matching/four_dof_transform.h"
 
 namespace cairn {
 
@@ -33,6 +34,7 @@ struct GraphStageReport {
   uint64_t solves = 0;           // updates that re-optimized
   uint64_t reinitializations = 0;
   uint64_t rejected_factors = 0;
+  uint64_t matches = 0;          // submap matches added as c factors
   // Estimates or switches the graph could not place: their frame is not connected to the chain
   // (an input was lost upstream). Counted, never guessed.
   uint64_t unplaced = 0;
@@ -42,9 +44,26 @@ struct GraphStageReport {
   std::vector<std::string> errors;  // the first few, verbatim
 };
 
+// One of the robot's submap origins as the graph places it now.
+struct OriginEstimate {
+  uint64_t frame_id = 0;
+  FourDofTransform T_global_origin;  // roll and pitch dropped (origins are gravity aligned)
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();  // (x, y, z, yaw), global axes
+  bool has_covariance = false;
+  bool connected = true;  // to the robot's prior
+};
+
 class GraphStage {
  public:
   GraphStage(const GraphStageOptions& options, bool deterministic);
+
+  // A submap match c (thesis 6.1) between two of the robot's origins: T_a_b with the matcher's
+  // (x, y, z, yaw) covariance in A's axes; roll and pitch get `tilt_sigma`. The factor takes the
+  // Cauchy loss; the graph re-optimizes. An error says why the graph refused it.
+  Status AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTransform& T_a_b,
+                  const Eigen::Matrix4d& covariance, double tilt_sigma);
+  // The robot's origins with, when `covariances`, their marginal covariances (a covariance solve).
+  std::vector<OriginEstimate> OriginEstimates(bool covariances);
 
   // Full solves after loop closures go through `runner` (live); without one they run inline.
   void SetBackgroundRunner(SlamGraph::BackgroundRunner runner) { graph_.SetBackgroundRunner(std::move(runner)); }

@@ -157,6 +157,7 @@ void MappingStage::ApplySwitchesUpTo(uint64_t frame_id) {
     if (const auto from = T_first_frame_.find(e.old_frame_id); from != T_first_frame_.end()) {
       T_first_frame_[e.new_frame_id] = from->second * e.transform.T_old_new;
     }
+    origin_times_.emplace(e.new_frame_id, e.time);
     ++report_.frame_switches;
     Keep(mapper_.OnFrameSwitch(e.new_frame_id, e.transform.T_old_new));
     frame_id_ = e.new_frame_id;
@@ -168,6 +169,7 @@ void MappingStage::Map(const DepthImage& image, const FrameEstimate& e) {
     // The first frame mapped is the map's frame, as it is trajectory.tum's.
     frame_id_ = e.frame_id;
     T_first_frame_[e.frame_id] = Eigen::Isometry3d::Identity();
+    origin_times_.emplace(e.frame_id, e.time);
   }
   ApplySwitchesUpTo(e.frame_id);
   if (e.frame_id != frame_id_) {
@@ -202,6 +204,7 @@ void MappingStage::Map(const DepthImage& image, const FrameEstimate& e) {
 void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   if (submap == nullptr) return;
   ++report_.submaps_finished;
+  if (submap_queue_ != nullptr) submap_queue_->TryPush(submap);
   const uint64_t id = submap->metadata().id;
   const auto pose = T_first_frame_.find(id);
   if (pose != T_first_frame_.end()) {
@@ -224,10 +227,16 @@ void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   report_.submap_bytes += bytes->size();
 }
 
-void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins) {
+void MappingStage::FinishSubmaps() {
+  if (submaps_finished_) return;
+  submaps_finished_ = true;
   ProcessReady(/*final=*/true);
   ApplySwitchesUpTo(UINT64_MAX);
   Keep(mapper_.FinishOpenSubmap());
+}
+
+void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins) {
+  FinishSubmaps();
   if (graph_origins != nullptr && !T_first_frame_.empty()) PlaceByGraph(*graph_origins);
   composer_.Update();
   const std::vector<CloudPoint> cloud = composer_.Cloud();

@@ -21,6 +21,7 @@
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/estimation_stage.h"
 #include "daemon/pipeline/latency_histogram.h"
+#include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/mapping_stage_options.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
 #include "fpga/stereo_backend_switch.h"
@@ -78,6 +79,10 @@ class MappingStage {
   void OnFrameSwitch(const FrameSwitchEvent& e) { switches_.push_back(e); }
   // Maps every waiting image whose estimate is known. `final`: no more estimates will come.
   void ProcessReady(bool final);
+  // Finished submaps also go into `queue` (the matcher's; a full queue drops and counts).
+  void PublishSubmapsTo(SpscQueue<std::shared_ptr<const Submap>>* queue) { submap_queue_ = queue; }
+  // End of the run, first part: maps what waits and finishes the open submap.
+  void FinishSubmaps();
   // End of the run: maps what waits, finishes the open submap and writes the map exports. With
   // `graph_origins` (T_global_frame per local frame, from the SLAM graph) the submaps are composed
   // at the graph's optimized origins instead of along the chain of frame switches.
@@ -86,6 +91,8 @@ class MappingStage {
   void SetTelemetry(TelemetryStage* telemetry) { telemetry_ = telemetry; }
 
   MappingStageReport report() const;
+  // When each local frame began (the frame switch into it; the first frame: its first estimate).
+  const std::map<uint64_t, Timestamp>& origin_times() const { return origin_times_; }
   const LatencyHistogram& match_time() const { return match_time_; }
   const LatencyHistogram& map_time() const { return map_time_; }
   size_t waiting_images() const { return waiting_.size(); }
@@ -100,6 +107,9 @@ class MappingStage {
   void Error(const std::string& what);
 
   MappingSetup setup_;
+  SpscQueue<std::shared_ptr<const Submap>>* submap_queue_ = nullptr;
+  std::map<uint64_t, Timestamp> origin_times_;
+  bool submaps_finished_ = false;
   std::unique_ptr<StereoBackendSwitch> matcher_;
   // Both passes over matcher_ when stereo.bidirectional is on; null otherwise.
   std::unique_ptr<BidirectionalRasterMatcher> bidirectional_;

@@ -31,6 +31,7 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       mapping_estimate_queue_(256),
       switch_event_queue_(16),
       graph_queue_(static_cast<size_t>(queues.graph)),
+      submap_queue_(static_cast<size_t>(queues.submaps)),
       imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
       estimation_exec_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
@@ -38,6 +39,7 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       mapping_exec_("mapping", executors.mapping),
       graph_exec_("graph", executors.graph),
       graph_full_solve_exec_("graph_full_solve", executors.graph_full_solve),
+      matcher_options_(executors.matcher),
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
@@ -89,6 +91,16 @@ Status Pipeline::EnableGraph(const GraphStageOptions& options) {
   return Status::Ok();
 }
 
+Status Pipeline::EnableMatching(const SubmapMatchingOptions& options, const std::string& robot) {
+  if (started_) return FailedPreconditionError("EnableMatching() after Start()");
+  if (!mapping_ || !graph_) return FailedPreconditionError("submap matching needs mapping and the graph enabled");
+  if (Status s = options.matcher.Validate(); !s.ok()) return s.WithContext("matching.matcher");
+  matching_ = std::make_unique<SubmapMatchingStage>(options, robot, deterministic_, matcher_options_,
+                                                    [this] { graph_signal_.Notify(); });
+  mapping_->PublishSubmapsTo(&submap_queue_);
+  return Status::Ok();
+}
+
 void Pipeline::SetTelemetry(TelemetryStage* telemetry) {
   telemetry_ = telemetry;
   if (mapping_) mapping_->SetTelemetry(telemetry);
@@ -108,6 +120,7 @@ void Pipeline::Start() {
   stereo_.Start([this](std::stop_token stop) { StereoLoop(stop); });
   if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
   if (mapping_) mapping_exec_.Start([this](std::stop_token stop) { MappingLoop(stop); });
+  if (matching_) matching_->Start();
   if (graph_) graph_exec_.Start([this](std::stop_token stop) { GraphLoop(stop); });
   if (graph_ && !deterministic_) {
     graph_full_solve_exec_.Start([this](std::stop_token stop) { graph_worker_.Run(stop); });
@@ -137,11 +150,20 @@ void Pipeline::StopAndDrain() {
   estimation_exec_.RequestStop();
   estimation_signal_.Notify();
   estimation_exec_.Join();
+  // The last submaps are finished before the graph stops, so that they are matched too.
+  if (mapping_ && matching_) {
+    TakeMappingInputs();
+    mapping_->FinishSubmaps();
+  }
   // The graph takes everything the filter made, then solves to convergence.
   if (graph_) {
     graph_exec_.RequestStop();
     graph_signal_.Notify();
     graph_exec_.Join();
+    if (matching_) {
+      TakeSubmaps(UINT64_MAX);
+      matching_->Drain(*graph_);
+    }
     graph_->Finish();  // waits for a running full solve, so its worker stops after it
     graph_full_solve_exec_.RequestStop();
     graph_full_solve_exec_.Join();
@@ -370,6 +392,14 @@ void Pipeline::TakeMappingInputs() {
   }
 }
 
+void Pipeline::TakeSubmaps(uint64_t max_id) {
+  while (const std::shared_ptr<const Submap>* s = submap_queue_.Front()) {
+    if ((*s)->metadata().id > max_id) return;
+    matching_->OnSubmap(*s);
+    submap_queue_.PopFront();
+  }
+}
+
 void Pipeline::MappingLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { mapping_signal_.Notify(); });
   while (true) {
@@ -409,8 +439,20 @@ void Pipeline::GraphLoop(std::stop_token stop) {
     bool worked = false;
     while (const GraphInput* in = graph_queue_.Front()) {
       graph_->OnInput(*in);
+      // Submap k is finished before mapping asks to leave frame k + 1, so once the switch into
+      // frame n is in, every submap up to n - 2 is in the queue: a fixed point of the data flow.
+      const bool into_frame = in->kind == GraphInput::Kind::kFrameSwitch;
+      const uint64_t frame = in->frame_switch.new_frame_id;
       graph_queue_.PopFront();
       worked = true;
+      if (matching_ && into_frame && frame >= 2) {
+        TakeSubmaps(deterministic_ ? frame - 2 : UINT64_MAX);
+        matching_->Step(*graph_);
+      }
+    }
+    if (matching_ && !deterministic_) {
+      TakeSubmaps(UINT64_MAX);
+      matching_->Step(*graph_);
     }
     // The live view: at each new origin, else about once a second of data.
     const bool new_origin = graph_->submap_origins() != graph_shown_origins_;
@@ -446,6 +488,7 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
     }
   }
   if (graph_) out.push_back(r("graph", graph_queue_));
+  if (matching_) out.push_back(r("submaps", submap_queue_));
   return out;
 }
 
@@ -453,7 +496,7 @@ uint64_t Pipeline::total_dropped() const {
   return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
          rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
          estimate_queue_.dropped() + dense_queue_.dropped() + mapping_estimate_queue_.dropped() +
-         switch_event_queue_.dropped() + graph_queue_.dropped();
+         switch_event_queue_.dropped() + graph_queue_.dropped() + submap_queue_.dropped();
 }
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {
@@ -469,6 +512,9 @@ std::vector<ExecutorReport> Pipeline::executor_reports() const {
   if (mapping_) out.push_back(mapping_exec_.report());
   if (graph_) out.push_back(graph_exec_.report());
   if (graph_ && !deterministic_) out.push_back(graph_full_solve_exec_.report());
+  if (matching_) {
+    for (const ExecutorReport& w : matching_->executor_reports()) out.push_back(w);
+  }
   return out;
 }
 

@@ -23,6 +23,7 @@
 #include "daemon/pipeline/sensor_stream_stats.h"
 #include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
+#include "daemon/pipeline/submap_matching_stage.h"
 #include "daemon/pipeline/telemetry_stage.h"
 #include "daemon/pipeline/vo_stage.h"
 #include "daemon/telemetry/graph_scene_encoder.h"
@@ -106,6 +107,9 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   // Builds and optimizes the robot's SLAM graph from the filter's estimates and frame switches
   // (graph executor). Needs EnableEstimation() first; call before Start().
   Status EnableGraph(const GraphStageOptions& options);
+  // Matches finished submaps on the matcher pool and adds the matches to the graph (thesis 6.1).
+  // Needs EnableMapping() and EnableGraph() first; call before Start().
+  Status EnableMatching(const SubmapMatchingOptions& options, const std::string& robot);
   // Asks the filter to switch its frame of reference. One producer: the vo thread (the interim
   // distance/sigma policy) or, with mapping enabled, the mapping thread through the
   // FrameSwitchRequesterInterface below.
@@ -143,8 +147,13 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   bool mapping_enabled() const { return mapping_ != nullptr; }
   // Valid after StopAndDrain() when mapping is enabled.
   MappingStageReport mapping_report() const;
+  std::map<uint64_t, Timestamp> submap_origin_times() const {
+    return mapping_ ? mapping_->origin_times() : std::map<uint64_t, Timestamp>{};
+  }
   // Valid after StopAndDrain(); null when the graph is not enabled.
   const GraphStage* graph() const { return graph_.get(); }
+  // Valid after StopAndDrain(); null when matching is not enabled.
+  const SubmapMatchingStage* matching() const { return matching_.get(); }
   FaultReport fault_report() const;
 
   // Live progress (any thread).
@@ -164,6 +173,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void GraphLoop(std::stop_token stop);
   void DrainEstimates();
   void TakeMappingInputs();
+  // Graph thread: finished submaps up to `max_id` into the matching stage.
+  void TakeSubmaps(uint64_t max_id);
 
   const bool deterministic_;
   WorkSignal estimation_signal_;
@@ -193,6 +204,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   WorkSignal graph_signal_;
   SpscQueue<GraphInput> graph_queue_;
   uint64_t graph_inputs_seen_ = 0;  // estimation thread: when to wake the graph thread
+  // Matching: mapping -> graph thread (finished submaps).
+  SpscQueue<std::shared_ptr<const Submap>> submap_queue_;
   const Duration imu_deadline_;
   std::atomic<uint64_t> deadline_misses_{0};
 
@@ -203,6 +216,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   Executor graph_exec_;
   GraphWorker graph_worker_{false};  // runs on graph_full_solve_exec_
   Executor graph_full_solve_exec_;
+  ExecutorOptions matcher_options_;  // the matcher pool's workers
 
   // Owned by the estimation thread until joined.
   SensorStreamStats imu_stats_;
@@ -224,6 +238,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   int pending_dropped_ = 0;
   std::unique_ptr<MappingStage> mapping_;
   std::unique_ptr<GraphStage> graph_;
+  std::unique_ptr<SubmapMatchingStage> matching_;
   GraphSceneEncoder graph_scene_;       // graph thread: the live /graph view
   uint64_t graph_shown_origins_ = 0;
   Timestamp graph_shown_time_;

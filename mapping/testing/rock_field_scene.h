@@ -169,6 +169,30 @@ inline Eigen::Isometry3d YawPose(double yaw, const Eigen::Vector3d& t) {
   return T;
 }
 
+// A submap of `points` (submap frame) whose occupancy tree is cast from each of `viewpoints`
+// (submap frame) to every point; no viewpoints: an empty tree.
+inline std::shared_ptr<const Submap> RayCastSubmap(std::vector<CloudPoint> points,
+                                                   const std::vector<Eigen::Vector3d>& viewpoints,
+                                                   const SubmapOptions& options, double max_range) {
+  std::unique_ptr<octomap::OcTree> tree = MakeOccupancyTree(options);
+  if (!viewpoints.empty()) {
+    OccupancyIntegrator integrator(options.octree_resolution, max_range);
+    CameraPoints cam;
+    cam.p_local.reserve(points.size());
+    for (const CloudPoint& c : points) cam.p_local.push_back(c.p);
+    cam.p_cam = cam.p_local;
+    for (const Eigen::Vector3d& v : viewpoints) {
+      cam.T_local_cam.translation() = v;
+      integrator.Integrate(cam, tree.get());
+    }
+    tree->updateInnerOccupancy();
+    tree->prune();
+  }
+  SubmapMetadata metadata;
+  metadata.options = options;
+  return std::make_shared<const Submap>(metadata, std::move(points), std::move(tree));
+}
+
 struct SceneSubmapOptions {
   double x_min = -1e9, x_max = 1e9;  // world x range the submap saw
   double noise = 0.01;               // m, Gaussian per sample and axis
@@ -192,24 +216,9 @@ inline std::shared_ptr<const Submap> SceneSubmap(const std::vector<ScenePoint>& 
     const Eigen::Vector3d noisy = sp.p + Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
     cloud.Add((T_submap_world * noisy).cast<float>(), sp.r, sp.g, sp.b, sp.obstacle);
   }
-  std::vector<CloudPoint> points = cloud.Points();
-  std::unique_ptr<octomap::OcTree> tree = MakeOccupancyTree(options);
-  if (!o.viewpoints.empty()) {
-    OccupancyIntegrator integrator(options.octree_resolution, 8.0);
-    CameraPoints cam;
-    cam.p_local.reserve(points.size());
-    for (const CloudPoint& c : points) cam.p_local.push_back(c.p);
-    cam.p_cam = cam.p_local;
-    for (const Eigen::Vector3d& v : o.viewpoints) {
-      cam.T_local_cam.translation() = T_submap_world * v;
-      integrator.Integrate(cam, tree.get());
-    }
-    tree->updateInnerOccupancy();
-    tree->prune();
-  }
-  SubmapMetadata metadata;
-  metadata.options = options;
-  return std::make_shared<const Submap>(metadata, std::move(points), std::move(tree));
+  std::vector<Eigen::Vector3d> viewpoints;
+  for (const Eigen::Vector3d& v : o.viewpoints) viewpoints.push_back(T_submap_world * v);
+  return RayCastSubmap(cloud.Points(), viewpoints, options, 8.0);
 }
 
 // Two submaps of one rock field from origins 1.1 rad and a few metres apart, each seeing a part of

@@ -1,0 +1,38 @@
+#pragma once
+// `matching:` in a cairnd profile: submap matching (thesis 6.1) on the matcher pool. Finished
+// submaps are paired by the graph's current estimates (eqs. 6.1 to 6.4), matched at low priority,
+// and each match enters the graph as a factor c under the Cauchy loss.
+
+#include <cstdint>
+
+#include "common/options_visitor.h"
+#include "mapping/matching/submap_feature_extractor.h"
+#include "mapping/matching/submap_matcher.h"
+#include "mapping/matching/submap_pairing.h"
+
+namespace cairn {
+
+struct SubmapMatchingOptions {
+  bool enabled = false;
+  int64_t workers = 1;  // matcher pool threads (executors.matcher schedules them)
+  int64_t queue = 4;    // jobs handed to the pool and not yet finished
+  // Roll and pitch between two gravity-aligned origins, which a 4-DoF match does not measure.
+  double tilt_sigma = 0.01;  // rad
+  bool write_csv = true;            // OUT/matches.csv
+  SubmapFeatureOptions features;
+  SubmapPairingOptions pairing;
+  SubmapMatcherOptions matcher;
+
+  void Visit(OptionsVisitor& v) {
+    v.Flag("enabled", enabled);
+    v.Integer("workers", workers, 1, 64, "threads");
+    v.Integer("queue", queue, 1, 1024, "jobs");
+    v.Number("tilt_sigma", tilt_sigma, 1e-6, 1.0, "rad");
+    v.Flag("write_csv", write_csv);
+    v.Section("features", features);
+    v.Section("pairing", pairing);
+    v.Section("matcher", matcher);
+  }
+};
+
+}  // namespace cairn

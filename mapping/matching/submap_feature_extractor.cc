@@ -1,0 +1,39 @@
+#include "mapping/matching/submap_feature_extractor.h"
+
+#include <chrono>
+
+namespace cairn {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
+  SubmapFeatures f;
+  const auto start = std::chrono::steady_clock::now();
+  const SubmapSuitability suitability(options_.suitability);
+  f.suitability = suitability.CheckCloud(submap.points());
+  f.cloud.reserve(static_cast<size_t>(f.suitability.points));
+  for (const CloudPoint& c : submap.points()) {
+    if (!c.p.allFinite()) continue;
+    f.cloud.push_back(c.p.cast<double>());
+    if (c.obstacle) f.obstacle_box_xy.extend(c.p.head<2>().cast<double>());
+  }
+  if (f.suitability.suitable()) {
+    f.keypoints = KeypointExtractor(options_.keypoints).Extract(submap);
+    f.suitability = suitability.Check(submap, f.keypoints.points);
+  }
+  f.keypoint_ms = MsSince(start);
+  if (!f.suitability.suitable()) return f;
+
+  const auto describe_start = std::chrono::steady_clock::now();
+  GravityShotDescriptor descriptor(submap.points(), options_.descriptor);
+  f.described = descriptor.ComputeAll(f.keypoints.points);
+  f.descriptor_ms = MsSince(describe_start);
+  return f;
+}
+
+}  // namespace cairn

@@ -1,0 +1,57 @@
+#pragma once
+// What the matcher needs of one submap, computed once and reused for every pair it is in (thesis
+// 6.1.1, 6.1.2): the suitability verdict, keypoints, their descriptors, the finite cloud for the
+// ICP and the xy box of the obstacle points for pairing.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/options_visitor.h"
+#include "mapping/matching/gravity_shot_descriptor.h"
+#include "mapping/matching/keypoint_extractor.h"
+#include "mapping/matching/submap_suitability.h"
+#include "mapping/submap.h"
+
+namespace cairn {
+
+struct SubmapFeatureOptions {
+  SuitabilityOptions suitability;
+  KeypointExtractorOptions keypoints;
+  GravityShotOptions descriptor;
+
+  void Visit(OptionsVisitor& v) {
+    v.Section("suitability", suitability);
+    v.Section("keypoints", keypoints);
+    v.Section("descriptor", descriptor);
+  }
+};
+
+struct SubmapFeatures {
+  SuitabilityResult suitability;
+  SubmapKeypoints keypoints;
+  DescribedKeypoints described;         // empty for an unsuitable submap
+  std::vector<Eigen::Vector3d> cloud;   // finite cloud points, submap frame
+  // xy extent of the finite obstacle points (submap frame); empty when there are none.
+  Eigen::AlignedBox2d obstacle_box_xy;
+  double keypoint_ms = 0.0;    // keypoints, known-space filter and suitability
+  double descriptor_ms = 0.0;  // descriptors (zero for an unsuitable submap)
+
+  bool suitable() const { return suitability.suitable(); }
+};
+
+class SubmapFeatureExtractor {
+ public:
+  explicit SubmapFeatureExtractor(const SubmapFeatureOptions& options = {}) : options_(options) {}
+
+  // Never fails: a submap that cannot be matched (too small, keypoints on a line, nothing
+  // finite) comes back unsuitable with the reason, and without descriptors.
+  SubmapFeatures Extract(const Submap& submap) const;
+
+ private:
+  SubmapFeatureOptions options_;
+};
+
+}  // namespace cairn

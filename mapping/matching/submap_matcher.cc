@@ -1,0 +1,241 @@
+#include "mapping/matching/submap_matcher.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+namespace cairn {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string Format(const char* format, auto... args) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, args...);
+  return buffer;
+}
+
+struct Hypothesis {
+  FourDofTransform T_a_b;
+  std::vector<uint32_t> a_keypoints, b_keypoints;  // of the RANSAC inliers
+  size_t inliers = 0;
+  double rms = 0.0;
+};
+
+// Counts rejections by kind and keeps the first message of each, so a failed attempt says how
+// every hypothesis ended rather than only how the last one did.
+class Rejections {
+ public:
+  void Add(std::string_view kind, std::string message) {
+    for (Entry& e : entries_) {
+      if (e.kind == kind) {
+        ++e.count;
+        return;
+      }
+    }
+    entries_.push_back({std::string(kind), std::move(message), 1});
+  }
+  std::string Summary(std::string_view none) const {
+    if (entries_.empty()) return std::string(none);
+    std::string out;
+    for (const Entry& e : entries_) {
+      if (!out.empty()) out += "; ";
+      out += e.count == 1 ? e.first : Format("%zu %s (first: ", e.count, e.kind.c_str()) + e.first + ")";
+    }
+    return out;
+  }
+
+ private:
+  struct Entry {
+    std::string kind, first;
+    size_t count;
+  };
+  std::vector<Entry> entries_;
+};
+
+}  // namespace
+
+std::string_view MatchStatusName(MatchStatus status) {
+  switch (status) {
+    case MatchStatus::kMatched:
+      return "matched";
+    case MatchStatus::kNoMatch:
+      return "no match";
+    case MatchStatus::kUnsuitable:
+      return "unsuitable";
+  }
+  return "?";
+}
+
+Status SubmapMatcherOptions::Validate() const {
+  if (Status s = ransac.Validate(); !s.ok()) return s;
+  if (Status s = icp.Validate(); !s.ok()) return s;
+  if (!(gate_sigmas > 0.0)) return InvalidArgumentError("matcher: gate_sigmas must be > 0");
+  if (max_refined_hypotheses < 1) return InvalidArgumentError("matcher: max_refined_hypotheses must be >= 1");
+  return Status::Ok();
+}
+
+bool SubmapMatcher::WithinGate(const FourDofTransform& T_a_b, const RelativePoseEstimate& prior,
+                               std::string* why) const {
+  static constexpr const char* kAxis[4] = {"x", "y", "z", "yaw"};
+  const Eigen::Vector4d d = T_a_b.ToVector() - prior.T_a_b.ToVector();
+  for (int i = 0; i < 4; ++i) {
+    const double off = i == 3 ? std::abs(WrapAngle(d[i])) : std::abs(d[i]);
+    const double sigma = std::sqrt(std::max(prior.covariance(i, i), 0.0));
+    const double floor = i == 3 ? options_.gate_floor_yaw : options_.gate_floor_translation;
+    const double bound = std::max(options_.gate_sigmas * sigma, floor);
+    if (!(off <= bound)) {
+      if (why != nullptr)
+        *why = Format("%s off the relative estimate by %.3f%s, gate %.3f", kAxis[i], off, i == 3 ? " rad" : " m",
+                      bound);
+      return false;
+    }
+  }
+  return true;
+}
+
+SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeatures& b,
+                                       const std::optional<RelativePoseEstimate>& prior) const {
+  const Clock::time_point start = Clock::now();
+  SubmapMatchResult r;
+  auto finish = [&](MatchStatus status, std::string reason) {
+    r.status = status;
+    r.reason = std::move(reason);
+    r.times.total_ms = MsSince(start);
+    return r;
+  };
+  if (Status s = options_.Validate(); !s.ok()) return finish(MatchStatus::kNoMatch, s.message());
+  if (!a.suitable()) return finish(MatchStatus::kUnsuitable, "submap A: " + a.suitability.message);
+  if (!b.suitable()) return finish(MatchStatus::kUnsuitable, "submap B: " + b.suitability.message);
+
+  // Correspondences and votes.
+  Clock::time_point stage = Clock::now();
+  const std::vector<KeypointCorrespondence> correspondences =
+      CorrespondenceFinder(options_.correspondences).Find(a.described.descriptors, b.described.descriptors);
+  r.correspondences = correspondences.size();
+  r.times.correspondences_ms = MsSince(stage);
+  stage = Clock::now();
+  const HoughResult votes = HoughVoting(options_.hough).Vote(a.described, b.described, correspondences);
+  r.clusters = votes.clusters.size();
+  r.times.hough_ms = MsSince(stage);
+  if (votes.clusters.empty())
+    return finish(MatchStatus::kNoMatch, Format("%zu correspondences, no vote cluster", correspondences.size()));
+
+  // One RANSAC per cluster; gate and spread checks per hypothesis.
+  stage = Clock::now();
+  const FourDofRansac ransac(options_.ransac);
+  SuitabilityOptions spread_options;
+  spread_options.off_line_distance = options_.off_line_distance;
+  const SubmapSuitability spread(spread_options);
+  std::vector<Hypothesis> hypotheses;
+  Rejections rejections;
+  std::vector<Eigen::Vector3d> source_b, target_a;
+  std::vector<Eigen::Vector3f> inlier_points;
+  for (const HoughCluster& cluster : votes.clusters) {
+    source_b.clear();
+    target_a.clear();
+    for (const uint32_t m : cluster.members) {
+      const KeypointCorrespondence& c = correspondences[m];
+      source_b.push_back(b.described.points[c.b].cast<double>());
+      target_a.push_back(a.described.points[c.a].cast<double>());
+    }
+    Expected<FourDofRansacResult> fit = ransac.Estimate(source_b, target_a);
+    if (!fit.ok()) {
+      rejections.Add("clusters without consensus", Format("cluster of %zu votes: %s", cluster.members.size(),
+                                                          fit.status().message().c_str()));
+      continue;
+    }
+    ++r.hypotheses;
+    Hypothesis h;
+    h.T_a_b = fit->T_a_b;
+    h.inliers = fit->inliers.size();
+    h.rms = fit->inlier_rms;
+    for (const size_t i : fit->inliers) {
+      const KeypointCorrespondence& c = correspondences[cluster.members[i]];
+      h.a_keypoints.push_back(c.a);
+      h.b_keypoints.push_back(c.b);
+    }
+    std::string why;
+    if (prior.has_value() && !WithinGate(h.T_a_b, *prior, &why)) {
+      ++r.gated_out;
+      rejections.Add("hypotheses outside the gate", "hypothesis " + why);
+      continue;
+    }
+    bool spread_ok = true;
+    for (const auto* side : {&a, &b}) {
+      const std::vector<uint32_t>& ids = side == &a ? h.a_keypoints : h.b_keypoints;
+      inlier_points.clear();
+      for (const uint32_t id : ids) inlier_points.push_back(side->described.points[id]);
+      const int64_t off = spread.OffLineKeypoints(inlier_points);
+      if (off < options_.min_off_line_inliers) {
+        spread_ok = false;
+        rejections.Add("hypotheses with keypoints on a line", Format("hypothesis keypoints on a line: %lld of %zu off it in submap %s, need %lld",
+                                static_cast<long long>(off), ids.size(), side == &a ? "A" : "B",
+                                static_cast<long long>(options_.min_off_line_inliers)));
+        break;
+      }
+    }
+    if (!spread_ok) {
+      ++r.spread_rejected;
+      continue;
+    }
+    hypotheses.push_back(std::move(h));
+  }
+  r.times.ransac_ms = MsSince(stage);
+  if (hypotheses.empty())
+    return finish(MatchStatus::kNoMatch, rejections.Summary("no cluster reached a RANSAC consensus"));
+  std::stable_sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& x, const Hypothesis& y) {
+    return x.inliers > y.inliers || (x.inliers == y.inliers && x.rms < y.rms);
+  });
+
+  // Refinement on the full clouds.
+  stage = Clock::now();
+  const FourDofIcp icp(options_.icp);
+  const size_t tries = std::min(hypotheses.size(), static_cast<size_t>(options_.max_refined_hypotheses));
+  for (size_t k = 0; k < tries; ++k) {
+    const Hypothesis& h = hypotheses[k];
+    ++r.refined;
+    const FourDofIcpResult fit = icp.Align(a.cloud, b.cloud, h.T_a_b);
+    r.icp_inliers = fit.inliers;
+    r.icp_rms = fit.rms;
+    r.icp_iterations = fit.iterations;
+    r.ransac_inliers = h.inliers;
+    if (!fit.ok()) {
+      rejections.Add("refinements failed", fit.status.message());
+      continue;
+    }
+    const FourDofTransform moved = h.T_a_b.inverse() * fit.T_a_b;
+    const double shift = moved.translation().norm();
+    std::string why;
+    if (shift > options_.max_refinement_translation || std::abs(moved.yaw()) > options_.max_refinement_yaw) {
+      rejections.Add("refinements moved too far", Format("icp left the hypothesis by %.3f m and %.3f rad", shift, std::abs(moved.yaw())));
+    } else if (fit.rms > options_.max_icp_rms) {
+      rejections.Add("refinements with a high residual",
+                     Format("icp residual %.3f m above %.3f m", fit.rms, options_.max_icp_rms));
+    } else if (static_cast<int64_t>(fit.inliers) < options_.min_icp_inliers) {
+      rejections.Add("refinements with few pairs", Format("icp paired %zu points, fewer than %lld", fit.inliers,
+                                                          static_cast<long long>(options_.min_icp_inliers)));
+    } else if (prior.has_value() && !WithinGate(fit.T_a_b, *prior, &why)) {
+      rejections.Add("refinements outside the gate", "refined match " + why);
+    } else {
+      r.T_a_b = fit.T_a_b;
+      r.covariance = fit.covariance;
+      const double ft = options_.covariance_floor_translation, fy = options_.covariance_floor_yaw;
+      r.covariance.diagonal() += Eigen::Vector4d(ft * ft, ft * ft, ft * ft, fy * fy);
+      r.times.icp_ms = MsSince(stage);
+      return finish(MatchStatus::kMatched,
+                    Format("%zu RANSAC inliers of %zu correspondences; icp %zu pairs, rms %.4f m", h.inliers,
+                           correspondences.size(), fit.inliers, fit.rms));
+    }
+  }
+  r.times.icp_ms = MsSince(stage);
+  return finish(MatchStatus::kNoMatch, rejections.Summary("no hypothesis refined"));
+}
+
+}  // namespace cairn

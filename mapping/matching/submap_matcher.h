@@ -1,0 +1,133 @@
+#pragma once
+// Pairwise matching of two gravity-aligned submaps (thesis 6.1.2): descriptor correspondences,
+// Hough voting both ways, a 4-DoF RANSAC per vote cluster, the gate against the graph's relative
+// estimate, the spread check of each hypothesis' keypoints, then point-to-plane 4-DoF ICP on the
+// full clouds from the best surviving hypothesis, gated again.
+//
+// The result is T_a_b (B's origin in A's frame) with its covariance from the ICP (x, y, z, yaw,
+// see four_dof_icp.h). Every rejection says which check failed and by how much, because matches
+// that fail are remembered by the pairing and shared with teammates.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "common/options_visitor.h"
+#include "common/status.h"
+#include "mapping/matching/correspondence_finder.h"
+#include "mapping/matching/four_dof_icp.h"
+#include "mapping/matching/four_dof_ransac.h"
+#include "mapping/matching/four_dof_transform.h"
+#include "mapping/matching/hough_voting.h"
+#include "mapping/matching/submap_feature_extractor.h"
+
+namespace cairn {
+
+struct SubmapMatcherOptions {
+  CorrespondenceFinderOptions correspondences;
+  HoughVotingOptions hough;
+  FourDofRansacOptions ransac;
+  FourDofIcpOptions icp;
+  // Hypotheses and the refined match must lie within gate_sigmas standard deviations of the
+  // relative estimate in each of x, y, z and yaw (thesis: 2, on x, y, z). The floors stand for the
+  // matcher's own error, so a relative estimate known better than the matcher cannot veto it.
+  double gate_sigmas = 2.0;
+  double gate_floor_translation = 0.05;  // m
+  double gate_floor_yaw = 0.01;          // rad
+  // Spread check of a hypothesis' inlier keypoints, in each submap: at least this many farther
+  // than off_line_distance (xy) from the line through them that leaves the fewest off it.
+  int64_t min_off_line_inliers = 2;
+  double off_line_distance = 0.5;  // m
+  // ICP results refused: too far from the hypothesis it started from (it left the hypothesis'
+  // basin), too large a residual, too few pairs.
+  double max_refinement_translation = 0.5;  // m
+  double max_refinement_yaw = 0.15;         // rad
+  double max_icp_rms = 0.05;                // m; point-to-plane
+  int64_t min_icp_inliers = 300;
+  // Hypotheses refined by the ICP, best first, until one is accepted.
+  int64_t max_refined_hypotheses = 2;
+  // Added (as variances) to the ICP's covariance, which treats every residual as independent: the
+  // errors the clouds' points share (each a centroid in a 0.05 m voxel, about 0.014 m RMS, and the
+  // stereo calibration) do not average out over thousands of pairs.
+  double covariance_floor_translation = 0.015;  // m
+  double covariance_floor_yaw = 0.002;          // rad
+
+  void Visit(OptionsVisitor& v) {
+    v.Section("correspondences", correspondences);
+    v.Section("hough", hough);
+    v.Section("ransac", ransac);
+    v.Section("icp", icp);
+    v.Number("gate_sigmas", gate_sigmas, 0.5, 100.0, "");
+    v.Number("gate_floor_translation", gate_floor_translation, 0.0, 100.0, "m");
+    v.Number("gate_floor_yaw", gate_floor_yaw, 0.0, 3.2, "rad");
+    v.Integer("min_off_line_inliers", min_off_line_inliers, 0, 1'000'000, "keypoints");
+    v.Number("off_line_distance", off_line_distance, 0.0, 100.0, "m");
+    v.Number("max_refinement_translation", max_refinement_translation, 0.0, 100.0, "m");
+    v.Number("max_refinement_yaw", max_refinement_yaw, 0.0, 3.2, "rad");
+    v.Number("max_icp_rms", max_icp_rms, 1e-4, 10.0, "m");
+    v.Integer("min_icp_inliers", min_icp_inliers, 5, 100'000'000, "pairs");
+    v.Integer("max_refined_hypotheses", max_refined_hypotheses, 1, 100, "");
+    v.Number("covariance_floor_translation", covariance_floor_translation, 0.0, 10.0, "m");
+    v.Number("covariance_floor_yaw", covariance_floor_yaw, 0.0, 1.0, "rad");
+  }
+  Status Validate() const;
+};
+
+// What the graph believes of T_a_b before the match, with its covariance (x, y, z, yaw).
+struct RelativePoseEstimate {
+  FourDofTransform T_a_b;
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Identity();
+};
+
+enum class MatchStatus { kMatched, kNoMatch, kUnsuitable };
+std::string_view MatchStatusName(MatchStatus status);
+
+struct MatchStageTimes {
+  double correspondences_ms = 0.0;
+  double hough_ms = 0.0;
+  double ransac_ms = 0.0;  // all clusters, with the gate and spread checks
+  double icp_ms = 0.0;
+  double total_ms = 0.0;
+};
+
+struct SubmapMatchResult {
+  MatchStatus status = MatchStatus::kNoMatch;
+  std::string reason;  // why not matched, or a summary of the match
+  FourDofTransform T_a_b;
+  // (x, y, z, yaw), A's axes; set when matched: the ICP's (four_dof_icp.h) plus the floors.
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+  size_t correspondences = 0;
+  size_t clusters = 0;
+  size_t hypotheses = 0;       // clusters whose RANSAC reached a consensus
+  size_t gated_out = 0;        // hypotheses outside the gate
+  size_t spread_rejected = 0;  // hypotheses whose keypoints lie on a line
+  size_t refined = 0;          // hypotheses handed to the ICP
+  size_t ransac_inliers = 0;   // of the hypothesis the match came from
+  size_t icp_inliers = 0;
+  double icp_rms = 0.0;
+  int64_t icp_iterations = 0;
+  MatchStageTimes times;
+
+  bool matched() const { return status == MatchStatus::kMatched; }
+};
+
+class SubmapMatcher {
+ public:
+  explicit SubmapMatcher(const SubmapMatcherOptions& options = {}) : options_(options) {}
+
+  // T_a_b between the submaps of `a` and `b`. Without `prior` there is no gate (a global search,
+  // e.g. `cairn match` without a guess).
+  SubmapMatchResult Match(const SubmapFeatures& a, const SubmapFeatures& b,
+                          const std::optional<RelativePoseEstimate>& prior = std::nullopt) const;
+
+  // Whether `T_a_b` lies within the gate around `prior`; otherwise `why` says which axis is off.
+  bool WithinGate(const FourDofTransform& T_a_b, const RelativePoseEstimate& prior, std::string* why) const;
+
+ private:
+  SubmapMatcherOptions options_;
+};
+
+}  // namespace cairn

@@ -1,0 +1,198 @@
+#include "mapping/matching/submap_matcher.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "mapping/matching/submap_feature_extractor.h"
+#include "mapping/testing/rock_field_scene.h"
+
+namespace cairn {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct Truth {
+  FourDofTransform T_a_b;
+};
+
+Truth TruthOf(const testing::ScenePair& pair) {
+  const Eigen::Isometry3d T_a_b = pair.T_world_a.inverse() * pair.T_world_b;
+  return {FourDofTransform::FromIsometry(T_a_b, 1e-9).value()};
+}
+
+double YawError(const FourDofTransform& x, const FourDofTransform& y) { return std::abs(WrapAngle(x.yaw() - y.yaw())); }
+
+void Print(const char* what, const SubmapMatchResult& r) {
+  std::printf(
+      "[ match   ] %s: %s (%s); %zu correspondences, %zu clusters, %zu hypotheses, %zu gated, %zu on a line; "
+      "%.1f ms (correspondences %.1f, hough %.1f, ransac %.1f, icp %.1f)\n",
+      what, std::string(MatchStatusName(r.status)).c_str(), r.reason.c_str(), r.correspondences, r.clusters,
+      r.hypotheses, r.gated_out, r.spread_rejected, r.times.total_ms, r.times.correspondences_ms,
+      r.times.hough_ms, r.times.ransac_ms, r.times.icp_ms);
+}
+
+class SubmapMatcherTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    pair_ = new testing::ScenePair(testing::OverlappingSubmaps(7));
+    const SubmapFeatureExtractor extractor;
+    features_a_ = new SubmapFeatures(extractor.Extract(*pair_->a));
+    features_b_ = new SubmapFeatures(extractor.Extract(*pair_->b));
+  }
+  static void TearDownTestSuite() {
+    delete pair_;
+    delete features_a_;
+    delete features_b_;
+  }
+  static testing::ScenePair* pair_;
+  static SubmapFeatures* features_a_;
+  static SubmapFeatures* features_b_;
+};
+testing::ScenePair* SubmapMatcherTest::pair_ = nullptr;
+SubmapFeatures* SubmapMatcherTest::features_a_ = nullptr;
+SubmapFeatures* SubmapMatcherTest::features_b_ = nullptr;
+
+TEST_F(SubmapMatcherTest, FeaturesOfASuitableSubmap) {
+  const SubmapFeatures& f = *features_a_;
+  EXPECT_TRUE(f.suitable()) << f.suitability.message;
+  EXPECT_GT(f.described.size(), 50u);
+  EXPECT_EQ(f.cloud.size(), pair_->a->points().size());
+  EXPECT_FALSE(f.obstacle_box_xy.isEmpty());
+  std::printf("[ match   ] features: %zu keypoints described; keypoints %.1f ms, descriptors %.1f ms\n",
+              f.described.size(), f.keypoint_ms, f.descriptor_ms);
+}
+
+TEST_F(SubmapMatcherTest, RecoversTheTrueTransformWithoutAGuess) {
+  const SubmapMatchResult r = SubmapMatcher().Match(*features_a_, *features_b_);
+  Print("no guess", r);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  const FourDofTransform truth = TruthOf(*pair_).T_a_b;
+  EXPECT_LT((r.T_a_b.translation() - truth.translation()).norm(), 0.05);
+  EXPECT_LT(YawError(r.T_a_b, truth), 0.5 * kDeg);
+  // The covariance is a covariance: symmetric, positive definite.
+  EXPECT_TRUE(r.covariance.isApprox(r.covariance.transpose()));
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(r.covariance).eigenvalues().minCoeff(), 0.0);
+}
+
+TEST_F(SubmapMatcherTest, MatchesTheOtherWayRoundToTheInverse) {
+  const SubmapMatchResult ab = SubmapMatcher().Match(*features_a_, *features_b_);
+  const SubmapMatchResult ba = SubmapMatcher().Match(*features_b_, *features_a_);
+  ASSERT_TRUE(ab.matched() && ba.matched()) << ab.reason << " / " << ba.reason;
+  const FourDofTransform loop = ab.T_a_b * ba.T_a_b;
+  EXPECT_LT(loop.translation().norm(), 0.05);
+  EXPECT_LT(std::abs(loop.yaw()), 0.5 * kDeg);
+}
+
+TEST_F(SubmapMatcherTest, AGoodRelativeEstimateKeepsTheMatch) {
+  RelativePoseEstimate prior;
+  const FourDofTransform truth = TruthOf(*pair_).T_a_b;
+  prior.T_a_b = FourDofTransform(truth.translation() + Eigen::Vector3d(0.3, -0.2, 0.05), truth.yaw() + 0.05);
+  prior.covariance = Eigen::Vector4d(0.25, 0.25, 0.04, 0.01).asDiagonal();
+  const SubmapMatchResult r = SubmapMatcher().Match(*features_a_, *features_b_, prior);
+  Print("good guess", r);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_LT((r.T_a_b.translation() - truth.translation()).norm(), 0.05);
+}
+
+TEST_F(SubmapMatcherTest, AConfidentWrongEstimateGatesTheMatchOut) {
+  RelativePoseEstimate prior;
+  const FourDofTransform truth = TruthOf(*pair_).T_a_b;
+  prior.T_a_b = FourDofTransform(truth.translation() + Eigen::Vector3d(1.5, 0.0, 0.0), truth.yaw());
+  prior.covariance = Eigen::Vector4d(0.04, 0.04, 0.01, 0.01).asDiagonal();
+  const SubmapMatchResult r = SubmapMatcher().Match(*features_a_, *features_b_, prior);
+  Print("wrong guess", r);
+  EXPECT_EQ(r.status, MatchStatus::kNoMatch);
+  EXPECT_GT(r.gated_out, 0u);
+  EXPECT_NE(r.reason.find("x off the relative estimate"), std::string::npos) << r.reason;
+  if (r.gated_out > 1) {
+    EXPECT_NE(r.reason.find(std::to_string(r.gated_out) + " hypotheses outside the gate"), std::string::npos)
+        << r.reason;
+  }
+}
+
+TEST_F(SubmapMatcherTest, GateNamesTheAxisThatIsOff) {
+  RelativePoseEstimate prior;
+  prior.covariance = Eigen::Vector4d(0.01, 0.01, 0.01, 0.0001).asDiagonal();
+  const SubmapMatcher matcher;
+  std::string why;
+  EXPECT_TRUE(matcher.WithinGate(FourDofTransform(0.15, -0.15, 0.1, 0.015), prior, &why));
+  EXPECT_FALSE(matcher.WithinGate(FourDofTransform(0.0, 0.0, 0.0, 0.03), prior, &why));
+  EXPECT_NE(why.find("yaw"), std::string::npos) << why;
+  // A yaw across +-pi is a small difference.
+  prior.T_a_b = FourDofTransform(0.0, 0.0, 0.0, std::numbers::pi - 0.005);
+  EXPECT_TRUE(matcher.WithinGate(FourDofTransform(0.0, 0.0, 0.0, -std::numbers::pi + 0.005), prior, &why));
+  // Floors: a prior known to a millimetre still accepts the matcher's own error.
+  prior.T_a_b = FourDofTransform();
+  prior.covariance = Eigen::Matrix4d::Identity() * 1e-8;
+  EXPECT_TRUE(matcher.WithinGate(FourDofTransform(0.04, 0.0, 0.0, 0.0), prior, &why));
+  prior.covariance(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(matcher.WithinGate(FourDofTransform(0.5, 0.0, 0.0, 0.0), prior, &why));
+}
+
+TEST(SubmapMatcherSceneTest, SubmapsOfDisjointPartsDoNotMatch) {
+  testing::RockFieldOptions o;
+  o.seed = 21;
+  const std::vector<testing::ScenePoint> scene = testing::RockField(o);
+  testing::SceneSubmapOptions sa, sb;
+  sa.x_max = -1.0;
+  sb.x_min = 1.0;
+  sb.seed = 12;
+  sa.viewpoints = {{-4.0, -2.0, 1.5}, {-2.0, 2.0, 1.5}};
+  sb.viewpoints = {{2.0, -2.0, 1.5}, {4.0, 2.0, 1.5}};
+  const auto a = testing::SceneSubmap(scene, testing::YawPose(0.2, {-3.0, 0.0, 0.0}), sa);
+  const auto b = testing::SceneSubmap(scene, testing::YawPose(-0.7, {3.0, 0.5, 0.1}), sb);
+  const SubmapFeatureExtractor extractor;
+  const SubmapFeatures fa = extractor.Extract(*a), fb = extractor.Extract(*b);
+  ASSERT_TRUE(fa.suitable() && fb.suitable()) << fa.suitability.message << " / " << fb.suitability.message;
+  const SubmapMatchResult r = SubmapMatcher().Match(fa, fb);
+  Print("disjoint", r);
+  EXPECT_EQ(r.status, MatchStatus::kNoMatch);
+}
+
+TEST(SubmapMatcherSceneTest, DifferentWorldsDoNotMatch) {
+  const testing::ScenePair x = testing::OverlappingSubmaps(3), y = testing::OverlappingSubmaps(5);
+  const SubmapFeatureExtractor extractor;
+  const SubmapMatchResult r = SubmapMatcher().Match(extractor.Extract(*x.a), extractor.Extract(*y.b));
+  Print("other world", r);
+  EXPECT_EQ(r.status, MatchStatus::kNoMatch);
+}
+
+TEST(SubmapMatcherSceneTest, EmptyAndTinySubmapsAreUnsuitableWithTheReason) {
+  SubmapMetadata metadata;
+  const auto empty = std::make_shared<const Submap>(metadata, std::vector<CloudPoint>{},
+                                                    MakeOccupancyTree(metadata.options));
+  const SubmapFeatureExtractor extractor;
+  const SubmapFeatures fe = extractor.Extract(*empty);
+  EXPECT_FALSE(fe.suitable());
+  EXPECT_EQ(fe.suitability.reason, SuitabilityReason::kTooFewPoints);
+  EXPECT_TRUE(fe.cloud.empty());
+  EXPECT_TRUE(fe.obstacle_box_xy.isEmpty());
+  const SubmapMatchResult r = SubmapMatcher().Match(fe, fe);
+  EXPECT_EQ(r.status, MatchStatus::kUnsuitable);
+  EXPECT_NE(r.reason.find("submap A: 0 points"), std::string::npos) << r.reason;
+}
+
+TEST(SubmapMatcherSceneTest, NonFinitePointsAreSkipped) {
+  const testing::ScenePair pair = testing::OverlappingSubmaps(7);
+  std::vector<CloudPoint> points = pair.b->points();
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i < points.size(); i += 7) points[i].p.x() = (i % 2 == 0) ? nan : inf;
+  const size_t broken = (points.size() + 6) / 7;
+  auto tree = MakeOccupancyTree(pair.b->metadata().options);
+  const auto b = std::make_shared<const Submap>(pair.b->metadata(), points, std::move(tree));
+  const SubmapFeatureExtractor extractor;
+  const SubmapFeatures fb = extractor.Extract(*b);
+  EXPECT_EQ(fb.suitability.non_finite_points, static_cast<int64_t>(broken));
+  EXPECT_EQ(fb.cloud.size(), points.size() - broken);
+  for (const Eigen::Vector3d& p : fb.cloud) ASSERT_TRUE(p.allFinite());
+}
+
+}  // namespace
+}  // namespace cairn

@@ -1,0 +1,328 @@
+// cairn match: one 4-DoF submap match between two submap files (mapping/matching/submap_matcher.h),
+// printed as JSON.
+// cairn bench match: features and matching timed on the submaps of cairnd runs, with recall and
+// precision against the simulator's truth in their submaps/index.csv.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <optional>
+#include <unordered_set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/json_writer.h"
+#include "mapping/matching/submap_feature_extractor.h"
+#include "mapping/matching/submap_matcher.h"
+#include "mapping/submap_codec.h"
+#include "tools/commands.h"
+
+namespace cairn::tools {
+namespace {
+
+constexpr const char* kMatchUsage =
+    "usage: cairn match A.submap B.submap [--guess x,y,z,yaw] [--sigma sx,sy,sz,syaw] [--dof 4]\n"
+    "  Matches submap B against submap A and prints T_a_b (B's origin in A's frame) as JSON.\n"
+    "  --guess   what is known of T_a_b (m, m, m, rad); the hypotheses and the result must lie within\n"
+    "            2 sigma of it. Without it the search is global.\n"
+    "  --sigma   standard deviations of the guess (default 1,1,0.5,0.3)\n"
+    "  --dof     4 (gravity-aligned submaps; the only variant built so far)\n";
+
+// Comma-separated finite numbers, exactly `count` of them.
+bool ParseList(const std::string& s, size_t count, std::vector<double>* out) {
+  out->clear();
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v)) return false;
+    out->push_back(v);
+  }
+  return out->size() == count;
+}
+
+void WriteTransform(JsonWriter& j, const FourDofTransform& T) {
+  j.Key("T_a_b").BeginObject();
+  j.Field("x", T.x()).Field("y", T.y()).Field("z", T.z()).Field("yaw", T.yaw());
+  j.Key("matrix").BeginArray();
+  const Eigen::Matrix4d m = T.ToIsometry().matrix();
+  for (int r = 0; r < 4; ++r) {
+    j.BeginArray();
+    for (int c = 0; c < 4; ++c) j.Number(m(r, c));
+    j.EndArray();
+  }
+  j.EndArray().EndObject();
+}
+
+void WriteFeatures(JsonWriter& j, const char* key, const std::string& path, const SubmapFeatures& f) {
+  j.Key(key).BeginObject();
+  j.Field("file", path);
+  j.Field("suitable", f.suitable());
+  j.Field("suitability", f.suitability.message);
+  j.Field("points", f.suitability.points);
+  j.Field("obstacle_points", f.suitability.obstacle_points);
+  j.Field("keypoints", f.keypoints.points.size());
+  j.Field("described_keypoints", f.described.size());
+  j.Field("keypoints_ms", f.keypoint_ms);
+  j.Field("descriptors_ms", f.descriptor_ms);
+  j.EndObject();
+}
+
+struct IndexedSubmap {
+  std::string robot;
+  uint64_t id = 0;
+  FourDofTransform T_world_submap;  // true origin
+  std::shared_ptr<const Submap> submap;
+  SubmapFeatures features;
+};
+
+// The rows of DIR/submaps/index.csv that have a true pose, with their submap files.
+Status ReadIndexedSubmaps(const std::string& dir, std::vector<IndexedSubmap>* out) {
+  const std::string index = dir + "/submaps/index.csv";
+  std::ifstream in(index);
+  if (!in) return NotFoundError(index + ": cannot open (a cairnd output folder with mapping on?)");
+  std::string line;
+  std::getline(in, line);
+  int row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    std::string item;
+    while (std::getline(fields, item, ',')) f.push_back(item);
+    if (f.size() < 7 || f[3].empty()) continue;  // no truth for this origin
+    std::vector<double> v;
+    if (!ParseList(f[3] + "," + f[4] + "," + f[5] + "," + f[6], 4, &v))
+      return InvalidArgumentError(index + ":" + std::to_string(row) + ": bad true pose");
+    IndexedSubmap s;
+    s.robot = f[0];
+    s.id = std::strtoull(f[1].c_str(), nullptr, 10);
+    s.T_world_submap = FourDofTransform(v[0], v[1], v[2], v[3]);
+    char name[32];
+    std::snprintf(name, sizeof(name), "-%06llu.submap", static_cast<unsigned long long>(s.id));
+    auto submap = SubmapCodec::ReadFile(dir + "/submaps/" + s.robot + name);
+    if (!submap.ok()) continue;  // listed but never finished (e.g. empty)
+    s.submap = *submap;
+    out->push_back(std::move(s));
+  }
+  return Status::Ok();
+}
+
+// Share of B's points within a 0.1 m voxel (or a neighbouring one) of A's points under T_a_b.
+double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a_b) {
+  constexpr double kVoxel = 0.1;
+  auto key = [](const Eigen::Vector3d& p) {
+    const int64_t x = static_cast<int64_t>(std::floor(p.x() / kVoxel)) & 0x1fffff;
+    const int64_t y = static_cast<int64_t>(std::floor(p.y() / kVoxel)) & 0x1fffff;
+    const int64_t z = static_cast<int64_t>(std::floor(p.z() / kVoxel)) & 0x1fffff;
+    return x | y << 21 | z << 42;
+  };
+  std::unordered_set<int64_t> occupied;
+  for (const CloudPoint& c : a.points()) {
+    if (c.p.allFinite()) occupied.insert(key(c.p.cast<double>()));
+  }
+  size_t near = 0, total = 0;
+  for (const CloudPoint& c : b.points()) {
+    if (!c.p.allFinite()) continue;
+    ++total;
+    const Eigen::Vector3d q = T_a_b * c.p.cast<double>();
+    bool hit = false;
+    for (int dx = -1; dx <= 1 && !hit; ++dx)
+      for (int dy = -1; dy <= 1 && !hit; ++dy)
+        for (int dz = -1; dz <= 1 && !hit; ++dz) hit = occupied.count(key(q + kVoxel * Eigen::Vector3d(dx, dy, dz))) != 0;
+    near += hit;
+  }
+  return total == 0 ? 0.0 : static_cast<double>(near) / static_cast<double>(total);
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+}  // namespace
+
+int RunBenchMatch(const CommandArgs& args) {
+  std::vector<std::string> dirs;
+  double min_overlap = 0.3;
+  for (size_t i = 0; i < args.args.size(); ++i) {
+    const std::string a = args.args[i];
+    std::vector<double> v;
+    if (a == "--min-overlap" && i + 1 < args.args.size() && ParseList(args.args[i + 1], 1, &v)) {
+      min_overlap = v[0];
+      ++i;
+    } else if (a.empty() || a[0] == '-') {
+      std::fprintf(stderr,
+                   "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)]\n"
+                   "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n");
+      return 2;
+    } else {
+      dirs.push_back(a);
+    }
+  }
+  if (dirs.empty()) {
+    std::fprintf(stderr, "cairn bench match: name at least one cairnd output folder (e.g. out/rover)\n");
+    return 2;
+  }
+  std::vector<IndexedSubmap> submaps;
+  for (const std::string& d : dirs) {
+    if (Status s = ReadIndexedSubmaps(d, &submaps); !s.ok()) {
+      std::fprintf(stderr, "cairn bench match: %s\n", s.ToString().c_str());
+      return 1;
+    }
+  }
+  const SubmapFeatureExtractor extractor;
+  std::vector<double> feature_ms;
+  size_t suitable = 0;
+  for (IndexedSubmap& s : submaps) {
+    s.features = extractor.Extract(*s.submap);
+    feature_ms.push_back(s.features.keypoint_ms + s.features.descriptor_ms);
+    suitable += s.features.suitable();
+  }
+  std::printf("cairn bench match: %zu submaps with true origins from %zu folders, %zu suitable\n", submaps.size(),
+              dirs.size(), suitable);
+  std::printf("  keypoints + descriptors per submap: median %.1f ms, max %.1f ms\n", Median(feature_ms),
+              feature_ms.empty() ? NAN : *std::max_element(feature_ms.begin(), feature_ms.end()));
+  const SubmapMatcher matcher;
+  std::vector<double> match_ms;
+  size_t positives = 0, found = 0, matched = 0, correct = 0, negatives = 0, false_matches = 0;
+  for (size_t i = 0; i < submaps.size(); ++i) {
+    for (size_t j = i + 1; j < submaps.size(); ++j) {
+      const IndexedSubmap& a = submaps[i];
+      const IndexedSubmap& b = submaps[j];
+      if (a.robot == b.robot && (a.id + 1 == b.id || b.id + 1 == a.id)) continue;
+      if (!a.features.suitable() || !b.features.suitable()) continue;
+      const FourDofTransform truth = a.T_world_submap.inverse() * b.T_world_submap;
+      const double overlap = std::max(TrueOverlap(*a.submap, *b.submap, truth),
+                                      TrueOverlap(*b.submap, *a.submap, truth.inverse()));
+      const SubmapMatchResult r = matcher.Match(a.features, b.features);
+      match_ms.push_back(r.times.total_ms);
+      const FourDofTransform error = truth.inverse() * r.T_a_b;
+      const bool good = r.matched() && error.translation().norm() <= 0.05 && std::abs(error.yaw()) <= 0.5 * M_PI / 180;
+      matched += r.matched();
+      correct += good;
+      if (overlap >= min_overlap) {
+        ++positives;
+        found += good;
+      } else if (overlap < 0.01) {
+        ++negatives;
+        false_matches += r.matched();
+      }
+      std::printf("  %s/%llu - %s/%llu: overlap %3.0f %%, %-10s", a.robot.c_str(), static_cast<unsigned long long>(a.id),
+                  b.robot.c_str(), static_cast<unsigned long long>(b.id), 100.0 * overlap,
+                  std::string(MatchStatusName(r.status)).c_str());
+      if (r.matched()) {
+        std::printf(" error %.3f m %.2f deg", error.translation().norm(), std::abs(error.yaw()) * 180 / M_PI);
+      } else {
+        std::printf(" (%s)", r.reason.c_str());
+      }
+      std::printf(", %.0f ms\n", r.times.total_ms);
+    }
+  }
+  std::printf("  matching per pair (with ICP): median %.1f ms, max %.1f ms over %zu pairs\n", Median(match_ms),
+              match_ms.empty() ? NAN : *std::max_element(match_ms.begin(), match_ms.end()), match_ms.size());
+  std::printf("  recall: %zu of %zu pairs with >= %.0f %% true overlap matched within 5 cm and 0.5 deg\n", found,
+              positives, 100.0 * min_overlap);
+  std::printf("  precision: %zu of %zu matches within 5 cm and 0.5 deg; %zu of %zu pairs without overlap matched\n",
+              correct, matched, false_matches, negatives);
+  return 0;
+}
+
+int RunMatch(const CommandArgs& args) {
+  std::vector<std::string> files;
+  std::optional<RelativePoseEstimate> prior;
+  std::vector<double> guess, sigma = {1.0, 1.0, 0.5, 0.3};
+  for (size_t i = 0; i < args.args.size(); ++i) {
+    const std::string a = args.args[i];
+    const bool has_value = i + 1 < args.args.size();
+    if (a == "-h" || a == "--help") {
+      std::fputs(kMatchUsage, stdout);
+      return 0;
+    } else if (a == "--guess" && has_value) {
+      if (!ParseList(args.args[++i], 4, &guess)) {
+        std::fprintf(stderr, "cairn match: --guess needs four finite numbers x,y,z,yaw, got '%s'\n", args.args[i]);
+        return 2;
+      }
+    } else if (a == "--sigma" && has_value) {
+      if (!ParseList(args.args[++i], 4, &sigma) || sigma[0] <= 0 || sigma[1] <= 0 || sigma[2] <= 0 ||
+          sigma[3] <= 0) {
+        std::fprintf(stderr, "cairn match: --sigma needs four positive numbers sx,sy,sz,syaw, got '%s'\n",
+                     args.args[i]);
+        return 2;
+      }
+    } else if (a == "--dof" && has_value) {
+      const std::string dof = args.args[++i];
+      if (dof != "4") {
+        std::fprintf(stderr, "cairn match: --dof %s: only the 4-DoF matcher is built\n", dof.c_str());
+        return 2;
+      }
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "cairn match: unknown or incomplete option '%s'\n%s", a.c_str(), kMatchUsage);
+      return 2;
+    } else {
+      files.push_back(a);
+    }
+  }
+  if (files.size() != 2) {
+    std::fputs(kMatchUsage, stderr);
+    return 2;
+  }
+  if (!guess.empty()) {
+    prior.emplace();
+    prior->T_a_b = FourDofTransform(guess[0], guess[1], guess[2], guess[3]);
+    prior->covariance = Eigen::Vector4d(sigma[0] * sigma[0], sigma[1] * sigma[1], sigma[2] * sigma[2],
+                                        sigma[3] * sigma[3])
+                            .asDiagonal();
+  }
+  Expected<std::shared_ptr<const Submap>> a = SubmapCodec::ReadFile(files[0]);
+  Expected<std::shared_ptr<const Submap>> b = SubmapCodec::ReadFile(files[1]);
+  for (const auto* s : {&a, &b}) {
+    if (!s->ok()) {
+      std::fprintf(stderr, "cairn match: %s\n", s->status().ToString().c_str());
+      return 1;
+    }
+  }
+  const SubmapFeatureExtractor extractor;
+  const SubmapFeatures fa = extractor.Extract(**a), fb = extractor.Extract(**b);
+  const SubmapMatchResult r = SubmapMatcher().Match(fa, fb, prior);
+
+  JsonWriter j;
+  j.BeginObject();
+  j.Field("status", MatchStatusName(r.status));
+  j.Field("reason", r.reason);
+  j.Field("dof", 4);
+  WriteFeatures(j, "a", files[0], fa);
+  WriteFeatures(j, "b", files[1], fb);
+  if (r.matched()) {
+    WriteTransform(j, r.T_a_b);
+    j.Key("covariance_order").BeginArray().String("x").String("y").String("z").String("yaw").EndArray();
+    j.Key("covariance").BeginArray();
+    for (int row = 0; row < 4; ++row) {
+      j.BeginArray();
+      for (int c = 0; c < 4; ++c) j.Number(r.covariance(row, c));
+      j.EndArray();
+    }
+    j.EndArray();
+  }
+  j.Key("counts").BeginObject();
+  j.Field("correspondences", r.correspondences).Field("clusters", r.clusters).Field("hypotheses", r.hypotheses);
+  j.Field("gated_out", r.gated_out).Field("spread_rejected", r.spread_rejected).Field("refined", r.refined);
+  j.Field("ransac_inliers", r.ransac_inliers).Field("icp_inliers", r.icp_inliers);
+  j.Field("icp_rms", r.icp_rms).Field("icp_iterations", r.icp_iterations);
+  j.EndObject();
+  j.Key("time_ms").BeginObject();
+  j.Field("keypoints", fa.keypoint_ms + fb.keypoint_ms).Field("descriptors", fa.descriptor_ms + fb.descriptor_ms);
+  j.Field("correspondences", r.times.correspondences_ms).Field("hough", r.times.hough_ms);
+  j.Field("ransac", r.times.ransac_ms).Field("icp", r.times.icp_ms).Field("match_total", r.times.total_ms);
+  j.EndObject();
+  j.EndObject();
+  std::printf("%s\n", j.str().c_str());
+  return 0;
+}
+
+}  // namespace cairn::tools
