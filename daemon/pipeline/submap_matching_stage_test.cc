@@ -14,6 +14,7 @@ namespace {
 
 using testing::LoopMission;
 using testing::MakeLoop;
+using testing::OriginError;
 
 TEST(SubmapMatchingStageTest, ClosesTheLoopAndTheGraphMovesToTheTruth) {
   const LoopMission m = MakeLoop(6);
