@@ -177,6 +177,24 @@ TEST(FourDofIcpTest, FlatPlaneIsDegenerate) {
   EXPECT_LT(r.observability, 0.005);
 }
 
+// Rolling ground without rocks (slopes up to about 7 %, as on the simulator's terrain) constrains
+// x, y and yaw only weakly per point, but over thousands of points well enough: not degenerate.
+TEST(FourDofIcpTest, RollingGroundIsObservable) {
+  std::vector<Eigen::Vector3d> ground;
+  SampleRect({-4.0, -4.0, 0.0}, {8.0, 0.0, 0.0}, {0.0, 8.0, 0.0}, 0.05, 0.5, &ground);
+  for (Eigen::Vector3d& p : ground) p.z() = 0.1 * std::sin(p.x() / 1.5) * std::cos(p.y() / 1.7) + 0.03 * p.x();
+  const std::vector<Eigen::Vector3d> target = Cloud(ground, -10.0, 10.0, FourDofTransform(), 0.01, 9);
+  const std::vector<Eigen::Vector3d> source = Cloud(ground, -10.0, 10.0, kTruth.inverse(), 0.01, 10);
+  const FourDofTransform start(kTruth.translation() + Eigen::Vector3d(0.05, -0.05, 0.0), kTruth.yaw() + 1.0 * kDeg);
+  const FourDofIcpResult r = FourDofIcp().Align(target, source, start);
+  std::printf("rolling ground: observability %.4f, %zu inliers\n", r.observability, r.inliers);
+  ASSERT_TRUE(r.ok()) << r.status.ToString();
+  EXPECT_GT(r.observability, FourDofIcpOptions{}.min_observability);
+  EXPECT_LT(r.observability, 0.005);  // what the first threshold called degenerate
+  EXPECT_LT((r.T_a_b.translation() - kTruth.translation()).norm(), 0.03);
+  EXPECT_LT(std::abs(r.T_a_b.yaw() - kTruth.yaw()), 0.2 * kDeg);
+}
+
 TEST(FourDofIcpTest, SingleWallLeavesTheMotionAlongItFree) {
   std::vector<Eigen::Vector3d> corridor;
   SampleRect({-3.0, -3.0, 0.0}, {6.0, 0.0, 0.0}, {0.0, 6.0, 0.0}, 0.1, 0.5, &corridor);
