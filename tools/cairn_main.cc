@@ -1,13 +1,33 @@
 // cairn: offline tools around the cairnd daemon (stereo, evaluation, benchmarks, graphs, ...).
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "tools/cairn_command.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
+
+bool ParseNumberList(const std::string& s, std::vector<double>* out) {
+  out->clear();
+  size_t start = 0;
+  while (start <= s.size()) {
+    const size_t comma = std::min(s.find(',', start), s.size());
+    const std::string item = s.substr(start, comma - start);
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || *end != '\0' || !std::isfinite(v)) return false;
+    out->push_back(v);
+    start = comma + 1;
+  }
+  return !out->empty();
+}
+
 namespace {
 
 constexpr auto kCommands = std::to_array<Command>({
@@ -31,6 +51,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"bench map", "time local mapping (classification, submap integration, wire size, composition)", RunBenchMap},
     {"match", "match two submap files (4-DoF: keypoints, descriptors, RANSAC, ICP) and print T_a_b as JSON", RunMatch},
     {"bench match", "time submap matching on cairnd runs' submaps; recall and precision against the simulator", RunBenchMatch},
+    {"detect", "AprilTag 36h11 tags in a photo: corners, T_cam_tag and its covariance as JSON", RunDetect},
     {"eval", "trajectory accuracy vs ground truth (TUM/EuRoC): ATE, RPE, drift as JSON", RunEval},
     {"bench vo", "visual-odometry time per stereo frame on an EuRoC/ASL folder (no SGM)", RunBenchVo},
 });

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "tools/cairn_command.h"
 
 namespace cairn::tools {
@@ -9,6 +12,8 @@ double ThreadCpuMs();
 // CPU time of the whole process (all threads) in ms: unlike wall time it barely depends on what
 // else runs on the machine, so it still compares work spread over threads when cores are shared.
 double ProcessCpuMs();
+// Comma-separated finite numbers (at least one) into `out`; false on anything else.
+bool ParseNumberList(const std::string& s, std::vector<double>* out);
 
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);
@@ -41,6 +46,7 @@ int RunBenchMap(const CommandArgs& args);
 int RunEval(const CommandArgs& args);
 int RunBenchVo(const CommandArgs& args);
 int RunMatch(const CommandArgs& args);
+int RunDetect(const CommandArgs& args);
 int RunBenchMatch(const CommandArgs& args);
 
 }  // namespace cairn::tools

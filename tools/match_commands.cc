@@ -33,16 +33,7 @@ constexpr const char* kMatchUsage =
 
 // Comma-separated finite numbers, exactly `count` of them.
 bool ParseList(const std::string& s, size_t count, std::vector<double>* out) {
-  out->clear();
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) return false;
-    out->push_back(v);
-  }
-  return out->size() == count;
+  return ParseNumberList(s, out) && out->size() == count;
 }
 
 void WriteTransform(JsonWriter& j, const FourDofTransform& T) {

@@ -83,9 +83,8 @@ Expected<Eigen::Isometry3d> ReadTBS(const YAML::Node& root, const std::string& p
   return T;
 }
 
-Expected<CameraCalibration> ReadCamera(const std::string& dir, const std::string& name,
+Expected<CameraCalibration> ReadCamera(const std::string& path, const std::string& name,
                                        double* rate_hz) {
-  const std::string path = dir + "/sensor.yaml";
   auto y = LoadSensorYaml(path);
   if (!y.ok()) return y.status();
   CameraCalibration cam;
@@ -205,9 +204,9 @@ Expected<EurocDataset> EurocDataset::Open(const std::string& root_in) {
 
   // Cameras: pair rows by identical timestamps.
   double rate0 = 0.0, rate1 = 0.0;
-  auto cam0 = ReadCamera(mav0 + "/cam0", "cam0", &rate0);
+  auto cam0 = ReadCamera(mav0 + "/cam0/sensor.yaml", "cam0", &rate0);
   if (!cam0.ok()) return cam0.status();
-  auto cam1 = ReadCamera(mav0 + "/cam1", "cam1", &rate1);
+  auto cam1 = ReadCamera(mav0 + "/cam1/sensor.yaml", "cam1", &rate1);
   if (!cam1.ok()) return cam1.status();
   ds.stereo_calibration_.left = *cam0;
   ds.stereo_calibration_.right = *cam1;
@@ -241,6 +240,11 @@ Expected<EurocDataset> EurocDataset::Open(const std::string& root_in) {
   const std::string gt = mav0 + "/state_groundtruth_estimate0/data.csv";
   if (fs::is_regular_file(gt)) ds.groundtruth_path_ = gt;
   return ds;
+}
+
+Expected<CameraCalibration> EurocDataset::ReadCameraFile(const std::string& sensor_yaml) {
+  double rate = 0.0;
+  return ReadCamera(sensor_yaml, "camera", &rate);
 }
 
 }  // namespace cairn

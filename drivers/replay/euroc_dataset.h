@@ -23,6 +23,8 @@ class EurocDataset {
  public:
   // `root` is the folder that holds mav0/ (or mav0 itself).
   static Expected<EurocDataset> Open(const std::string& root);
+  // One camera's sensor.yaml (EuRoC/Kalibr form: resolution, intrinsics, radial-tangential).
+  static Expected<CameraCalibration> ReadCameraFile(const std::string& sensor_yaml);
 
   const std::string& root() const { return root_; }
   const std::vector<ImuSample>& imu() const { return imu_; }

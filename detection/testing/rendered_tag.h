@@ -1,0 +1,67 @@
+#pragma once
+// Test helper: a tag36h11 tag drawn into a gray image at a known pose, by a homography of its
+// bitmap (libapriltag's own), over a gray background, with a little optical blur.
+
+#include <cstdlib>
+#include <memory>
+
+#include <apriltag/apriltag.h>
+#include <apriltag/tag36h11.h>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "hal/calibration.h"
+#include "hal/image.h"
+
+namespace cairn::testing {
+
+// The tag's black border spans 8 of the bitmap's 10 cells; the frame is AprilTag's (x right, y
+// down as printed, z into the tag).
+inline cv::Mat RenderTag(int id, double tag_size, const Eigen::Isometry3d& T_cam_tag, const PinholeRadTan& camera,
+                         double blur_sigma = 0.6) {
+  apriltag_family_t* family = tag36h11_create();
+  image_u8_t* bits = apriltag_to_image(family, id);
+  constexpr int kUp = 8;  // bitmap pixels per cell
+  cv::Mat bitmap(bits->height * kUp, bits->width * kUp, CV_8UC1);
+  for (int v = 0; v < bitmap.rows; ++v)
+    for (int u = 0; u < bitmap.cols; ++u) bitmap.at<uint8_t>(v, u) = bits->buf[(v / kUp) * bits->stride + u / kUp];
+  const double cells = bits->width;  // 10
+  // image_u8_destroy is not exported by Debian's libapriltag; it frees these two blocks.
+  std::free(bits->buf);
+  std::free(bits);
+  tag36h11_destroy(family);
+  const double cell = tag_size / 8.0;
+  // Bitmap pixel centre -> tag plane (metres).
+  Eigen::Matrix3d A = Eigen::Matrix3d::Identity();
+  A(0, 0) = A(1, 1) = cell / kUp;
+  A(0, 2) = A(1, 2) = (0.5 / kUp - 0.5 * cells) * cell;
+  Eigen::Matrix3d P;
+  P.col(0) = T_cam_tag.linear().col(0);
+  P.col(1) = T_cam_tag.linear().col(1);
+  P.col(2) = T_cam_tag.translation();
+  Eigen::Matrix3d K;
+  K << camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0;
+  const Eigen::Matrix3d H = K * P * A;
+  cv::Matx33d Hcv;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) Hcv(r, c) = H(r, c);
+  cv::Mat out;
+  cv::warpPerspective(bitmap, out, Hcv, cv::Size(camera.width, camera.height), cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT, cv::Scalar(128));
+  if (blur_sigma > 0.0) cv::GaussianBlur(out, out, cv::Size(0, 0), blur_sigma);
+  return out;
+}
+
+// A view of a continuous 8-bit cv::Mat as an Image (the Mat must outlive it).
+inline Image ImageOf(const cv::Mat& m) {
+  Image image;
+  image.data = std::shared_ptr<const uint8_t[]>(m.data, [](const uint8_t*) {});
+  image.width = m.cols;
+  image.height = m.rows;
+  image.stride = static_cast<int>(m.step[0]);
+  image.format = PixelFormat::kGray8;
+  return image;
+}
+
+}  // namespace cairn::testing
