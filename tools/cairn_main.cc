@@ -52,6 +52,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"match", "match two submap files (4-DoF: keypoints, descriptors, RANSAC, ICP) and print T_a_b as JSON", RunMatch},
     {"bench match", "time submap matching on cairnd runs' submaps; recall and precision against the simulator", RunBenchMatch},
     {"detect", "AprilTag 36h11 tags in a photo: corners, T_cam_tag and its covariance as JSON", RunDetect},
+    {"bench detect", "time AprilTag detection on simulated rover frames: whole frame and region of interest", RunBenchDetect},
     {"eval", "trajectory accuracy vs ground truth (TUM/EuRoC): ATE, RPE, drift as JSON", RunEval},
     {"bench vo", "visual-odometry time per stereo frame on an EuRoC/ASL folder (no SGM)", RunBenchVo},
 });

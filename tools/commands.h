@@ -47,6 +47,7 @@ int RunEval(const CommandArgs& args);
 int RunBenchVo(const CommandArgs& args);
 int RunMatch(const CommandArgs& args);
 int RunDetect(const CommandArgs& args);
+int RunBenchDetect(const CommandArgs& args);
 int RunBenchMatch(const CommandArgs& args);
 
 }  // namespace cairn::tools

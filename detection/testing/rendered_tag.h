@@ -16,10 +16,11 @@
 
 namespace cairn::testing {
 
-// The tag's black border spans 8 of the bitmap's 10 cells; the frame is AprilTag's (x right, y
-// down as printed, z into the tag).
-inline cv::Mat RenderTag(int id, double tag_size, const Eigen::Isometry3d& T_cam_tag, const PinholeRadTan& camera,
-                         double blur_sigma = 0.6) {
+// Draws the tag into `image` (8-bit gray, camera.width x camera.height). The tag's black border
+// spans 8 of the bitmap's 10 cells (the outer white cells are drawn too); the frame is AprilTag's
+// (x right, y down as printed, z into the tag).
+inline void DrawTag(cv::Mat& image, int id, double tag_size, const Eigen::Isometry3d& T_cam_tag,
+                    const PinholeRadTan& camera, double blur_sigma = 0.6) {
   apriltag_family_t* family = tag36h11_create();
   image_u8_t* bits = apriltag_to_image(family, id);
   constexpr int kUp = 8;  // bitmap pixels per cell
@@ -46,11 +47,27 @@ inline cv::Mat RenderTag(int id, double tag_size, const Eigen::Isometry3d& T_cam
   cv::Matx33d Hcv;
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c) Hcv(r, c) = H(r, c);
-  cv::Mat out;
-  cv::warpPerspective(bitmap, out, Hcv, cv::Size(camera.width, camera.height), cv::INTER_LINEAR,
-                      cv::BORDER_CONSTANT, cv::Scalar(128));
-  if (blur_sigma > 0.0) cv::GaussianBlur(out, out, cv::Size(0, 0), blur_sigma);
-  return out;
+  const cv::Size size(camera.width, camera.height);
+  cv::Mat tag, mask;
+  cv::warpPerspective(bitmap, tag, Hcv, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::warpPerspective(cv::Mat(bitmap.size(), CV_8UC1, cv::Scalar(255)), mask, Hcv, size, cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT, cv::Scalar(0));
+  cv::Mat blended;
+  image.convertTo(blended, CV_32F);
+  cv::Mat t32, m32;
+  tag.convertTo(t32, CV_32F);
+  mask.convertTo(m32, CV_32F, 1.0 / 255.0);
+  blended = blended.mul(1.0 - m32) + t32.mul(m32);
+  if (blur_sigma > 0.0) cv::GaussianBlur(blended, blended, cv::Size(0, 0), blur_sigma);
+  blended.convertTo(image, CV_8U);
+}
+
+// A tag drawn over a plain gray background.
+inline cv::Mat RenderTag(int id, double tag_size, const Eigen::Isometry3d& T_cam_tag, const PinholeRadTan& camera,
+                         double blur_sigma = 0.6) {
+  cv::Mat image(camera.height, camera.width, CV_8UC1, cv::Scalar(128));
+  DrawTag(image, id, tag_size, T_cam_tag, camera, blur_sigma);
+  return image;
 }
 
 // A view of a continuous 8-bit cv::Mat as an Image (the Mat must outlive it).
