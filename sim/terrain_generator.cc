@@ -168,7 +168,7 @@ TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
   const int rock_count = static_cast<int>(std::lround(o.rock_density * hectares));
   for (int i = 0; i < rock_count; ++i) {
     const double cx = rng.Uniform(-half, half), cy = rng.Uniform(-half, half);
-    const double r = 0.05 * std::pow(10.0, rng.Uniform() * rng.Uniform());
+    const double r = o.rock_size * 0.05 * std::pow(10.0, rng.Uniform() * rng.Uniform());
     const double hr = r * rng.Uniform(0.5, 0.9);
     rocks.emplace_back(cx, cy, r, hr);
     Stamp(t.heights, n, half, res, cx, cy, r, 1.0, [&](double s) { return hr * std::sqrt(std::max(0.0, 1.0 - s * s)); });

@@ -60,6 +60,27 @@ TEST(TerrainTest, RocksAddSteepStepsToTheGround) {
   EXPECT_GT(s1, 2.0);  // rock flanks: steeper than 60 deg
 }
 
+TEST(TerrainTest, RockSizeScalesTheBoulders) {
+  WorldOptions flat = SmallWorld();
+  flat.relief = 0.0;
+  flat.crater_density = 0.0;
+  flat.big_crater = false;
+  flat.rock_density = 2000.0;
+  WorldOptions big = flat;
+  big.rock_size = 3.0;
+  auto highest = [](const Terrain& t) {
+    double m = 0.0;
+    for (double x = -9.5; x < 9.5; x += 0.05) {
+      for (double y = -9.5; y < 9.5; y += 0.05) m = std::max(m, t.Height(x, y));
+    }
+    return m;
+  };
+  const double h1 = highest(Terrain::Generate(flat)), h3 = highest(Terrain::Generate(big));
+  // The same rocks (same draws), each three times as tall.
+  EXPECT_GT(h3, 2.5 * h1);
+  EXPECT_LT(h3, 3.5 * h1);
+}
+
 // The max-mipmap traversal must return the first intersection: the hit lies on the surface and
 // no sample before it along the ray is below the surface.
 TEST(TerrainTest, RaycastFindsTheFirstSurfaceHit) {

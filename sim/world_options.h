@@ -16,7 +16,8 @@ struct WorldOptions {
   int64_t seed = 1;
   double relief = 1.2;            // amplitude of the multi-octave height field
   double crater_density = 40.0;   // craters per hectare (radius 0.5-4 m)
-  double rock_density = 600.0;    // boulders per hectare (radius 0.05-0.5 m)
+  double rock_density = 600.0;    // boulders per hectare (radius 0.05-0.5 m times rock_size)
+  double rock_size = 1.0;         // scale of every boulder's radius and height
   bool big_crater = true;         // one large crater with a steep rim (cliff-like negative edge)
   double sun_azimuth = 135.0;     // from +x towards +y
   double sun_elevation = 35.0;
@@ -32,6 +33,7 @@ struct WorldOptions {
     v.Number("relief", relief, 0.0, 20.0, "m");
     v.Number("crater_density", crater_density, 0.0, 2000.0, "1/ha");
     v.Number("rock_density", rock_density, 0.0, 20000.0, "1/ha");
+    v.Number("rock_size", rock_size, 0.1, 10.0, "");
     v.Flag("big_crater", big_crater);
     v.Number("sun_azimuth", sun_azimuth, -360.0, 360.0, "deg");
     v.Number("sun_elevation", sun_elevation, 5.0, 90.0, "deg");
