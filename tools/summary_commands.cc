@@ -24,23 +24,23 @@ double CountOf(const JsonValue& streams, const char* name) {
 
 // Simulated runs carry their ground truth: score the estimate against it. Returns the alignment
 // of the estimate's frame to the world when the evaluation succeeded.
-std::optional<Eigen::Isometry3d> PrintAccuracy(const std::string& dir) {
-  const std::string est_path = dir + "/trajectory.tum", gt_path = dir + "/ground_truth.tum";
+// `file`'s accuracy against the simulator's (or the data set's) ground truth, labelled `what`.
+std::optional<Eigen::Isometry3d> PrintAccuracy(const std::string& dir, const std::string& file, const char* what) {
+  const std::string est_path = dir + "/" + file, gt_path = dir + "/ground_truth.tum";
   if (!std::filesystem::exists(est_path) || !std::filesystem::exists(gt_path)) return std::nullopt;
   auto est = TrajectoryIo::Read(est_path, TrajectoryFormat::kTum);
   auto gt = TrajectoryIo::Read(gt_path, TrajectoryFormat::kTum);
   if (!est.ok() || !gt.ok()) {
-    std::printf("  accuracy: unreadable trajectory (%s)\n",
+    std::printf("  %s: unreadable trajectory (%s)\n", what,
                 (!est.ok() ? est.status() : gt.status()).message().c_str());
     return std::nullopt;
   }
   auto r = EvaluateTrajectory(*gt, *est, TrajectoryEvalOptions{});
   if (!r.ok()) {
-    std::printf("  accuracy: %s\n", r.status().message().c_str());
+    std::printf("  %s: %s\n", what, r.status().message().c_str());
     return std::nullopt;
   }
-  std::printf("  accuracy vs ground truth: %.2f m path, ATE RMSE %.3f m, drift %.3f m / %.2f deg yaw",
-              r->path_length, r->ate_rmse, r->drift_translation, r->drift_yaw_deg);
+  std::printf("  %s: %.2f m path, ATE RMSE %.3f m, drift %.3f m / %.2f deg yaw", what, r->path_length, r->ate_rmse, r->drift_translation, r->drift_yaw_deg);
   for (const SegmentError& e : r->segments) {
     if (e.pairs > 0) {
       std::printf(", RPE@%.0fm %.2f %% %.3f deg/m", e.length, e.translation_percent, e.rotation_deg_per_m);
@@ -111,7 +111,23 @@ int RunSummary(const CommandArgs& args) {
                     g["submap_origins"].number(), g["robot_poses"].number(), g["factors"].number(),
                     g["rejected_factors"].number(), g["unplaced"].number(), g["chi2"].number());
       }
-      const std::optional<Eigen::Isometry3d> T_world_est = PrintAccuracy(dir);
+      if (s.has("matching")) {
+        const JsonValue& m = s["matching"];
+        std::printf("  matching: %.0f submaps (%.0f suitable), %.0f attempts, %.0f matched, %.0f in the graph",
+                    m["submaps"].number(), m["suitable"].number(), m["attempts"].number(), m["matched"].number(),
+                    m["accepted"].number());
+        if (m.has("pairs")) {
+          const char* sep = "; pairs: ";
+          for (const auto& [why, count] : m["pairs"].object()) {
+            std::printf("%s%.0f %s", sep, count.number(), why.c_str());
+            sep = ", ";
+          }
+        }
+        std::printf("\n");
+      }
+      const std::optional<Eigen::Isometry3d> T_world_est = PrintAccuracy(dir, "trajectory.tum", "accuracy vs ground truth");
+      if (std::filesystem::exists(std::string(dir) + "/global_trajectory.tum"))
+        PrintAccuracy(dir, "global_trajectory.tum", "global (graph) vs ground truth");
       if (T_world_est && s["mode"].string() == "sim") PrintMapAccuracy(dir, *T_world_est);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());
