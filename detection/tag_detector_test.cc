@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <apriltag/tag25h9.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -149,6 +150,33 @@ TEST(TagDetectorTest, BadImagesAndRegionsAreRefusedWithTheReason) {
   const auto plain = detector.Detect(testing::ImageOf(gray));
   ASSERT_TRUE(plain.ok());
   EXPECT_TRUE(plain->empty());
+}
+
+// Tags of another family, and a tag seen almost edge-on, are simply not found: no crash, no
+// false id.
+TEST(TagDetectorTest, OtherFamiliesAndEdgeOnTagsAreNotReported) {
+  const PinholeRadTan camera{640, 480, 500.0, 500.0, 320.0, 240.0};
+  const Eigen::Isometry3d ahead(Eigen::Translation3d(0.0, 0.0, 1.0));
+  cv::Mat other(camera.height, camera.width, CV_8UC1, cv::Scalar(128));
+  apriltag_family_t* family = tag25h9_create();
+  testing::DrawTag(other, 3, 0.16, ahead, camera, 0.6, family);
+  tag25h9_destroy(family);
+  TagDetectorOptions o;
+  o.decimate = 1.0;
+  TagDetector detector(o);
+  const auto none = detector.Detect(testing::ImageOf(other));
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none->empty());
+  Eigen::Isometry3d edge_on = ahead;
+  edge_on.linear() = Eigen::AngleAxisd(89.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const auto edge = detector.Detect(testing::ImageOf(testing::RenderTag(3, 0.16, edge_on, camera)));
+  ASSERT_TRUE(edge.ok());
+  EXPECT_TRUE(edge->empty());
+  // The same tag turned 60 deg is still found.
+  edge_on.linear() = Eigen::AngleAxisd(60.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const auto turned = detector.Detect(testing::ImageOf(testing::RenderTag(3, 0.16, edge_on, camera)));
+  ASSERT_TRUE(turned.ok());
+  EXPECT_EQ(turned->size(), 1u);
 }
 
 TEST(TagDetectorTest, InvalidIdsFailEveryDetectionWithTheReason) {

@@ -19,20 +19,21 @@ namespace cairn::testing {
 // Draws the tag into `image` (8-bit gray, camera.width x camera.height). The tag's black border
 // spans 8 of the bitmap's 10 cells (the outer white cells are drawn too); the frame is AprilTag's
 // (x right, y down as printed, z into the tag).
+// `family` (default tag36h11) is the code family drawn; its black border must span 8 of 10 cells.
 inline void DrawTag(cv::Mat& image, int id, double tag_size, const Eigen::Isometry3d& T_cam_tag,
-                    const PinholeRadTan& camera, double blur_sigma = 0.6) {
-  apriltag_family_t* family = tag36h11_create();
+                    const PinholeRadTan& camera, double blur_sigma = 0.6, apriltag_family_t* other_family = nullptr) {
+  apriltag_family_t* family = other_family != nullptr ? other_family : tag36h11_create();
   image_u8_t* bits = apriltag_to_image(family, id);
   constexpr int kUp = 8;  // bitmap pixels per cell
   cv::Mat bitmap(bits->height * kUp, bits->width * kUp, CV_8UC1);
   for (int v = 0; v < bitmap.rows; ++v)
     for (int u = 0; u < bitmap.cols; ++u) bitmap.at<uint8_t>(v, u) = bits->buf[(v / kUp) * bits->stride + u / kUp];
-  const double cells = bits->width;  // 10
+  const double cells = bits->width;  // 10 for tag36h11
   // image_u8_destroy is not exported by Debian's libapriltag; it frees these two blocks.
   std::free(bits->buf);
   std::free(bits);
-  tag36h11_destroy(family);
-  const double cell = tag_size / 8.0;
+  if (other_family == nullptr) tag36h11_destroy(family);
+  const double cell = tag_size / (cells - 2.0);
   // Bitmap pixel centre -> tag plane (metres).
   Eigen::Matrix3d A = Eigen::Matrix3d::Identity();
   A(0, 0) = A(1, 1) = cell / kUp;
