@@ -151,10 +151,16 @@ Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTra
     return NotFoundError("match between origins " + std::to_string(frame_a) + " and " + std::to_string(frame_b) +
                          ": not both in the graph");
   // (x, y, z, yaw) into the factor's (translation, rotation vector); yaw is the rotation about z.
+  // The matcher states the translation in A's frame; the factor's residual is in B's frame
+  // (R_ab^T (t - t_ab)), so the translation rows and columns turn by R_ab^T. The yaw axis is the
+  // same in both (gravity-aligned frames).
+  Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
+  R.topLeftCorner<3, 3>() = Eigen::AngleAxisd(T_a_b.yaw(), Eigen::Vector3d::UnitZ()).toRotationMatrix().transpose();
+  const Eigen::Matrix4d covariance_b = R * covariance * R.transpose();
   Matrix6d c = Matrix6d::Zero();
   const int index[4] = {0, 1, 2, 5};
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) c(index[i], index[j]) = covariance(i, j);
+    for (int j = 0; j < 4; ++j) c(index[i], index[j]) = covariance_b(i, j);
   c(3, 3) = c(4, 4) = tilt_sigma * tilt_sigma;
   SlamFactor f;
   f.kind = FactorKind::kMatch;

@@ -101,6 +101,44 @@ TEST(GraphStageTest, ChainOfFrameSwitchesPlacesEveryEstimate) {
   }
 }
 
+// A match's covariance is stated in A's frame. Between origins turned 90 deg apart, a match that
+// is sure along A's x and unsure along A's y must move the solution along A's x only.
+TEST(GraphStageTest, AMatchIsWeightedInTheAxesOfItsFirstSubmap) {
+  GraphStage g(Options(), /*deterministic=*/true);
+  GraphInput e;
+  e.kind = GraphInput::Kind::kEstimate;
+  e.estimate.valid = true;
+  e.estimate.time = Timestamp::FromSeconds(1.0);
+  e.estimate.frame_id = 0;
+  e.estimate.pose_covariance = Matrix6d::Identity() * 1e-6;
+  g.OnInput(e);
+  Eigen::Isometry3d T_0_1 = Eigen::Isometry3d::Identity();
+  T_0_1.translation() = Eigen::Vector3d(2.0, 1.0, 0.0);
+  T_0_1.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  GraphInput w;
+  w.kind = GraphInput::Kind::kFrameSwitch;
+  w.frame_switch.time = Timestamp::FromSeconds(2.0);
+  w.frame_switch.old_frame_id = 0;
+  w.frame_switch.new_frame_id = 1;
+  w.frame_switch.transform.T_old_new = T_0_1;
+  Matrix6d c = Matrix6d::Zero();
+  c.diagonal() << 0.01, 0.01, 0.01, 0.0, 0.0, 1e-4;
+  w.frame_switch.transform.covariance = c;
+  g.OnInput(w);
+  e.estimate.time = Timestamp::FromSeconds(3.0);
+  e.estimate.frame_id = 1;
+  g.OnInput(e);
+  // The match says 0.1 m further along A's x (sure) and 0.1 m along A's y (unsure).
+  const FourDofTransform match(2.1, 1.1, 0.0, M_PI / 2);
+  const Eigen::Matrix4d covariance = Eigen::Vector4d(1e-6, 1.0, 1e-4, 1e-6).asDiagonal();
+  ASSERT_TRUE(g.AddMatch(0, 1, match, covariance, 0.01).ok());
+  g.Finish();
+  const auto origins = g.FrameOrigins();
+  const Eigen::Vector3d t = (origins.at(0).inverse() * origins.at(1)).translation();
+  EXPECT_NEAR(t.x(), 2.1, 0.005);  // the match's sure axis
+  EXPECT_NEAR(t.y(), 1.0, 0.005);  // the odometry's, the match being unsure there
+}
+
 TEST(GraphStageTest, ExportedGraphReadsBackAsG2o) {
   const Drive d = MakeDrive(60, 20);
   GraphStage g(Options(), true);
