@@ -8,6 +8,16 @@
 namespace cairn {
 namespace {
 
+// A relative pose's covariance with its translation in the first frame (as the filter's switch
+// and the matcher state it) turned into the factor's, whose translation residual is in the second
+// frame (R_ab^T (t - t_ab), g2o's convention). The rotation part is a right perturbation already.
+Matrix6d TranslationInSecondFrame(const Matrix6d& covariance, const Eigen::Matrix3d& R_a_b) {
+  Matrix6d J = Matrix6d::Identity();
+  J.topLeftCorner<3, 3>() = R_a_b.transpose();
+  const Matrix6d c = J * covariance * J.transpose();
+  return 0.5 * (c + c.transpose());
+}
+
 Pose3 ToPose3(const Eigen::Isometry3d& T) {
   return Pose3{T.translation(), Eigen::Quaterniond(T.rotation()).normalized()};
 }
@@ -126,7 +136,9 @@ void GraphStage::OnFrameSwitch(const FrameSwitchEvent& e) {
   w.a = OriginKey(e.old_frame_id);
   w.b = OriginKey(e.new_frame_id);
   w.z = ToPose3(e.transform.T_old_new);
-  w.information = Floored(e.transform.covariance).inverse();
+  // The filter states the new origin's position error in the old frame.
+  w.information =
+      Floored(TranslationInSecondFrame(e.transform.covariance, e.transform.T_old_new.linear())).inverse();
   if (!Add(w)) {
     ++report_.unplaced;  // the new frame stays unknown: its estimates are counted as unplaced
     return;
@@ -150,18 +162,14 @@ Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTra
   if (!graph_.HasVariable(OriginKey(frame_a)) || !graph_.HasVariable(OriginKey(frame_b)))
     return NotFoundError("match between origins " + std::to_string(frame_a) + " and " + std::to_string(frame_b) +
                          ": not both in the graph");
-  // (x, y, z, yaw) into the factor's (translation, rotation vector); yaw is the rotation about z.
-  // The matcher states the translation in A's frame; the factor's residual is in B's frame
-  // (R_ab^T (t - t_ab)), so the translation rows and columns turn by R_ab^T. The yaw axis is the
-  // same in both (gravity-aligned frames).
-  Eigen::Matrix4d R = Eigen::Matrix4d::Identity();
-  R.topLeftCorner<3, 3>() = Eigen::AngleAxisd(T_a_b.yaw(), Eigen::Vector3d::UnitZ()).toRotationMatrix().transpose();
-  const Eigen::Matrix4d covariance_b = R * covariance * R.transpose();
+  // (x, y, z, yaw) into (translation, rotation vector); yaw is the rotation about z, the same axis
+  // in both gravity-aligned frames. The matcher states the translation in A's frame.
   Matrix6d c = Matrix6d::Zero();
   const int index[4] = {0, 1, 2, 5};
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) c(index[i], index[j]) = covariance_b(i, j);
+    for (int j = 0; j < 4; ++j) c(index[i], index[j]) = covariance(i, j);
   c(3, 3) = c(4, 4) = tilt_sigma * tilt_sigma;
+  c = TranslationInSecondFrame(c, T_a_b.ToIsometry().linear());
   SlamFactor f;
   f.kind = FactorKind::kMatch;
   f.a = OriginKey(frame_a);

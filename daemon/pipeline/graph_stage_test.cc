@@ -139,6 +139,37 @@ TEST(GraphStageTest, AMatchIsWeightedInTheAxesOfItsFirstSubmap) {
   EXPECT_NEAR(t.y(), 1.0, 0.005);  // the odometry's, the match being unsure there
 }
 
+// The filter states a switch's position error in the old frame: sure along the old x, unsure
+// along the old y. The new origin, turned 90 deg, must carry that uncertainty along the old
+// (here world) axes.
+TEST(GraphStageTest, ASwitchIsWeightedInTheAxesOfTheOldFrame) {
+  GraphStage g(Options(), /*deterministic=*/true);
+  GraphInput e;
+  e.kind = GraphInput::Kind::kEstimate;
+  e.estimate.valid = true;
+  e.estimate.time = Timestamp::FromSeconds(1.0);
+  e.estimate.frame_id = 0;
+  e.estimate.pose_covariance = Matrix6d::Identity() * 1e-6;
+  g.OnInput(e);
+  GraphInput w;
+  w.kind = GraphInput::Kind::kFrameSwitch;
+  w.frame_switch.time = Timestamp::FromSeconds(2.0);
+  w.frame_switch.old_frame_id = 0;
+  w.frame_switch.new_frame_id = 1;
+  w.frame_switch.transform.T_old_new = Eigen::Isometry3d(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  w.frame_switch.transform.T_old_new.translation() = Eigen::Vector3d(3.0, 0.0, 0.0);
+  Matrix6d c = Matrix6d::Zero();
+  c.diagonal() << 1e-4, 1e-2, 1e-4, 0.0, 0.0, 1e-6;
+  w.frame_switch.transform.covariance = c;
+  g.OnInput(w);
+  const std::vector<OriginEstimate> origins = g.OriginEstimates(/*covariances=*/true);
+  ASSERT_EQ(origins.size(), 2u);
+  const OriginEstimate& o = origins[1].frame_id == 1 ? origins[1] : origins[0];
+  ASSERT_TRUE(o.has_covariance);
+  EXPECT_NEAR(o.covariance(0, 0), 1e-4, 2e-5);  // world x = old x: sure
+  EXPECT_NEAR(o.covariance(1, 1), 1e-2, 2e-4);  // world y = old y: unsure
+}
+
 TEST(GraphStageTest, ExportedGraphReadsBackAsG2o) {
   const Drive d = MakeDrive(60, 20);
   GraphStage g(Options(), true);

@@ -52,7 +52,7 @@ client.on("advertise", (channels) => {
           : rootFor(ch).lookupType(ch.schemaName);
       const id = client.subscribe(ch.id);
       subs.set(id, { ch, type });
-      result.channels[ch.topic] = { schema: ch.schemaName, count: 0, increasing: true, last: null, decodeErrors: 0 };
+      result.channels[ch.topic] = { schema: ch.schemaName, count: 0, increasing: true, first: null, last: null, decodeErrors: 0 };
     } catch (e) {
       result.errors.push(`schema of ${ch.topic}: ${e.message}`);
     }
@@ -79,6 +79,7 @@ client.on("message", ({ subscriptionId, data }) => {
     const m = s.type.decode(new Uint8Array(data.buffer, data.byteOffset, data.byteLength));
     const t = timeOf(s.ch.topic, m);
     if (t !== null && r.last !== null && t <= BigInt(r.last)) r.increasing = false;
+    if (t !== null && r.first === null) r.first = t.toString();
     if (t !== null) r.last = t.toString();
     if (s.ch.topic.endsWith("/image")) r.lastImage = { width: m.width, height: m.height, bytes: m.data.length, encoding: m.encoding };
     if (s.ch.topic.endsWith("/image/compressed")) r.lastImage = { format: m.format, bytes: m.data.length, ...jpegSize(m.data) };
