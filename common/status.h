@@ -20,6 +20,7 @@ enum class StatusCode {
   kTimeout,
   kCancelled,
   kInternal,
+  kAlreadyExists,     // a thing made once is made again (e.g. an item held already)
 };
 
 const char* StatusCodeName(StatusCode code);
@@ -52,6 +53,7 @@ inline Status FailedPreconditionError(std::string m) { return {StatusCode::kFail
 inline Status OutOfRangeError(std::string m) { return {StatusCode::kOutOfRange, std::move(m)}; }
 inline Status TimeoutError(std::string m) { return {StatusCode::kTimeout, std::move(m)}; }
 inline Status InternalError(std::string m) { return {StatusCode::kInternal, std::move(m)}; }
+inline Status AlreadyExistsError(std::string m) { return {StatusCode::kAlreadyExists, std::move(m)}; }
 
 template <class T>
 class [[nodiscard]] Expected {

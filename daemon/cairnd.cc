@@ -9,11 +9,13 @@
 
 #include "common/atomic_file.h"
 #include "common/options_yaml_writer.h"
+#include "daemon/comms/comms_stage.h"
 #include "daemon/pipeline/pipeline.h"
 #include "daemon/run_summary.h"
 #include "daemon/submap_index.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
+#include "daemon/team_summary.h"
 #include "drivers/can_wheel_decoder.h"
 #include "drivers/replay/euroc_replay.h"
 #include "drivers/replay/mcap_replay.h"
@@ -30,6 +32,15 @@ const char* PacingName(ReplayPacing p) {
     case ReplayPacing::kFastAsPossible: return "fast";
   }
   return "fast";
+}
+
+const char* RobotKindName(RobotKind k) {
+  switch (k) {
+    case RobotKind::kRover: return "rover";
+    case RobotKind::kHexacopter: return "hexacopter";
+    case RobotKind::kHandheld: return "handheld";
+  }
+  return "rover";
 }
 
 }  // namespace
@@ -175,6 +186,38 @@ int Cairnd::Run() {
       }
     }
   }
+  std::unique_ptr<CommsStage> comms;
+  if (options_.team.enabled) {
+    if (pipeline.graph() == nullptr) {
+      spdlog::error("{}: team.enabled needs the graph (graph.enabled, vo.enabled and a calibrated source)", config_path_);
+      return 1;
+    }
+    CommsSetup setup;
+    setup.team = options_.team;
+    setup.robot = options_.robot.name;
+    setup.robot_kind = RobotKindName(options_.robot.kind);
+    setup.output_dir = options_.output.dir;
+    setup.executor = options_.executors.comms;
+    auto stage = CommsStage::Create(setup);
+    if (!stage.ok()) {
+      spdlog::error("team exchange: {}", stage.status().ToString());
+      return 1;
+    }
+    comms = std::move(*stage);
+    std::map<char, std::string> names;
+    for (const TeamMember& m : comms->team().members) names[m.letter[0]] = m.name;
+    if (Status s = pipeline.SetTeamLink(comms.get(), names); !s.ok()) {
+      spdlog::error("{}: {}", config_path_, s.ToString());
+      return 1;
+    }
+    if (comms->letter() != options_.graph.optimizer.own_robot) {
+      spdlog::error("{}: graph.optimizer.own_robot '{}' is not the letter {} gives '{}' ('{}')", config_path_,
+                    options_.graph.optimizer.own_robot, comms->team().path, options_.robot.name, comms->letter());
+      return 1;
+    }
+    comms->Start();
+    spdlog::info("team exchange: {} teammates in {}", comms->team().members.size() - 1, comms->team().path);
+  }
   std::unique_ptr<TelemetryStage> telemetry;
   if (options_.recording.enabled || options_.live.enabled) {
     telemetry = std::make_unique<TelemetryStage>(options_.executors.telemetry,
@@ -259,7 +302,8 @@ int Cairnd::Run() {
                                  std::to_string(pipeline.consumed_stereo()) + ", dropped " +
                                  std::to_string(pipeline.total_dropped()) + ", deadline misses " +
                                  std::to_string(pipeline.deadline_misses()) + ", faults " +
-                                 std::to_string(pipeline.fault_report().total);
+                                 std::to_string(pipeline.fault_report().total) +
+                                 (comms ? "; team: " + comms->LinkSummary() : std::string());
       if (telemetry) telemetry->PublishDiagnostics(status);
       notifier.Status(status);
       spdlog::debug("{}", status);
@@ -268,7 +312,12 @@ int Cairnd::Run() {
 
   notifier.Stopping();
   for (auto& s : sources_) s->Stop();
-  pipeline.StopAndDrain();
+  pipeline.StopAndDrain();  // with a team: lingers until the teammates hold the same logs
+  if (comms) {
+    comms->Stop();
+    run.extra_executors.push_back(comms->executor_report());
+    run.team_links = comms->report().links;
+  }
   if (telemetry) {
     telemetry->StopAndDrain();
     if (telemetry->recording()) run.recording = telemetry->recording_report();
@@ -284,7 +333,7 @@ int Cairnd::Run() {
                             deterministic, dataset_->stereo().size(), dataset_->unpaired_left(),
                             dataset_->unpaired_right(), dataset_->imu().size()};
   }
-  if (Status s = WriteOutputs(run, pipeline); !s.ok()) {
+  if (Status s = WriteOutputs(run, pipeline, comms.get()); !s.ok()) {
     spdlog::error("writing outputs failed: {}", s.ToString());
     return 1;
   }
@@ -311,7 +360,7 @@ Status Cairnd::WriteTrajectory(const std::string& stem, const Trajectory& trajec
   return Status::Ok();
 }
 
-Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
+Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const CommsStage* comms) {
   const std::string dir = options_.output.dir;
   CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/config.yaml", "# effective configuration of this run (from " +
                                                                       config_path_ + ")\n" +
@@ -331,6 +380,15 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline) {
   if (const GraphStage* graph = pipeline.graph()) {
     // The same estimates placed by the graph's optimized submap origins.
     CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory", graph->GlobalTrajectory()));
+    if (comms != nullptr) {
+      // Every robot the graph has tied to this one's frame, in it (eq. 4.6); the others have no
+      // global trajectory here (team.json says so).
+      for (const TeamMember& m : comms->team().members) {
+        const Trajectory t = graph->GlobalTrajectory(m.letter[0]);
+        if (!t.poses.empty()) CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory_" + m.name, t));
+      }
+      CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/team.json", BuildTeamJson(comms->report(), comms->team(), graph)));
+    }
     if (options_.graph.write_g2o) {
       CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/graph.g2o", FormatG2o(graph->ExportPoseGraph())));
     }

@@ -28,7 +28,7 @@ class Cairnd {
   static void BlockTerminationSignals();
 
  private:
-  Status WriteOutputs(const struct RunInfo& run, const class Pipeline& pipeline);
+  Status WriteOutputs(const struct RunInfo& run, const class Pipeline& pipeline, const class CommsStage* comms);
   // `stem` + .tum / .csv / .kitti (+ _times.txt), for each of output.trajectory_formats.
   Status WriteTrajectory(const std::string& stem, const Trajectory& trajectory) const;
 

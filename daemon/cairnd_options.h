@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/options_visitor.h"
+#include "daemon/comms/team_options.h"
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/executor_options.h"
 #include "daemon/pipeline/graph_stage_options.h"
@@ -110,6 +111,7 @@ struct CairndOptions {
   MappingStageOptions mapping;
   GraphStageOptions graph;
   SubmapMatchingOptions matching;
+  TeamOptions team;
 
   void Visit(OptionsVisitor& v) {
     v.Section("robot", robot);
@@ -131,6 +133,7 @@ struct CairndOptions {
     v.Section("mapping", mapping);
     v.Section("graph", graph);
     v.Section("matching", matching);
+    v.Section("team", team);
   }
 };
 

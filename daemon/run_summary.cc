@@ -255,6 +255,18 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
     j.Field("match_ms_p50", m.match_ms_p50).Field("match_ms_max", m.match_ms_max);
     j.EndObject();
   }
+  if (!run.team_links.empty()) {
+    // The exchange's links: bytes each way and the backlog of items the peer has not acknowledged.
+    j.Key("team_links").BeginArray();
+    for (const TeamLinkStatus& l : run.team_links) {
+      j.BeginObject();
+      j.Field("peer", l.peer).Field("sent_bytes", l.sent_bytes).Field("received_bytes", l.received_bytes);
+      j.Field("queued_items", l.queued_items).Field("queued_bytes", l.queued_bytes);
+      j.Field("queued_items_max", l.queued_items_max).Field("queued_bytes_max", l.queued_bytes_max);
+      j.EndObject();
+    }
+    j.EndArray();
+  }
   j.Key("queues").BeginArray();
   for (const QueueReport& q : p.queue_reports()) {
     j.BeginObject();

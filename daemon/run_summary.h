@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "daemon/comms/team_link_status.h"
 #include "daemon/pipeline/pipeline.h"
 #include "daemon/pipeline/telemetry_stage.h"
 
@@ -31,7 +32,8 @@ struct RunInfo {
   std::optional<LiveStreamReport> live;
   uint64_t telemetry_dropped = 0;
   uint64_t image_codec_failures = 0;  // images the PNG/JPEG encoder refused (recording or live)
-  std::vector<ExecutorReport> extra_executors;  // executors outside the pipeline (telemetry)
+  std::vector<ExecutorReport> extra_executors;  // executors outside the pipeline (telemetry, comms)
+  std::vector<TeamLinkStatus> team_links;       // with a team: each link at the end
   double wall_time = 0.0;   // s
   bool memory_locked = false;
   std::string memory_lock_note;

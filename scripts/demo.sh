@@ -1,21 +1,44 @@
 #!/usr/bin/env bash
 # The main job on the built-in default, no hardware needed: installs what is missing, builds the
-# release preset, and runs a simulated two-robot mission on the default world: one cairnd per
-# robot (rover and hexacopter, as on the robots), each writing ./out/<robot>. Then replays the
-# bundled real EuRoC excerpt into ./out/euroc when the shared data sets are present.
+# release preset, and runs a simulated mission of a team on the default world: one cairnd per robot
+# (two rovers and a hexacopter, as on the robots), talking over loopback through the team exchange
+# with CURVE keys made for the demo, each writing ./out/<robot>. Then replays the bundled real EuRoC
+# excerpt into ./out/euroc when the shared data sets are present.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 cmake --preset release >/dev/null
 cmake --build --preset release --target cairnd cairn
-duration="${CAIRN_DEMO_DURATION:-20}"
+duration="${CAIRN_DEMO_DURATION:-60}"
+port="${CAIRN_DEMO_PORT:-47701}"
 cairnd=./build/release/daemon/cairnd
-common=(--sim --set "sim.duration=$duration" --set replay.pacing=fast --set replay.deterministic=true
-        --set live.enabled=false --set recording.enabled=false --log-level warn)
-echo "demo: simulating a ${duration} s mission of a rover and a hexacopter on the default world"
+cairn=./build/release/tools/cairn
+robots=(rover hexacopter rover2)
+letters=(a b c)
+profiles=(rover hexacopter rover)
+team=out/team
+rm -rf "$team"
+mkdir -p "$team/keys"
+echo "members:" >"$team/team.yaml"
+for i in "${!robots[@]}"; do
+  r=${robots[$i]}
+  "$cairn" keys generate --name "$r" --dir "$team/keys" >/dev/null
+  key=$(awk '$1 == "public-key" {print $2}' "$team/keys/$r.pub")
+  echo "  - {name: $r, letter: ${letters[$i]}, address: \"tcp://127.0.0.1:$((port + i))\", public_key: \"$key\"}" \
+    >>"$team/team.yaml"
+done
+common=(--sim --set "sim.duration=$duration" --set "sim.robots=$(IFS=,; echo "${robots[*]}")"
+        --set replay.pacing=fast --set replay.deterministic=true --set live.enabled=false
+        --set recording.enabled=false --set team.enabled=true --set "team.members_file=$team/team.yaml"
+        --set team.linger=600 --log-level warn)
+echo "demo: simulating a ${duration} s mission of ${robots[*]} on the default world, exchanging over loopback"
 pids=()
-for robot in rover hexacopter; do
-  "$cairnd" --config "configs/$robot.yaml" "${common[@]}" --out "out/$robot" &
+for i in "${!robots[@]}"; do
+  r=${robots[$i]}
+  rm -rf "out/$r/exchange"  # a new mission: no items of an earlier one
+  "$cairnd" --config "configs/${profiles[$i]}.yaml" "${common[@]}" --set "robot.name=$r" \
+    --set "graph.optimizer.own_robot=${letters[$i]}" --set "team.secret_key_file=$team/keys/$r.key" \
+    --out "out/$r" &
   pids+=($!)
 done
 status=0
@@ -32,4 +55,4 @@ if [[ -d "$data" ]]; then
 else
   echo "demo: skipping the EuRoC replay: missing $data (the shared data sets next to this checkout)"
 fi
-./build/release/tools/cairn summary out/*/
+"$cairn" summary "${robots[@]/#/out/}" $([[ -d out/euroc ]] && echo out/euroc)

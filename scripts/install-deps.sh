@@ -27,6 +27,8 @@ packages=(
   libhwy-dev
   # FPGA offload (fpga/rtl): cosimulation and synthesis check
   verilator yosys
+  # the team exchange: ZeroMQ with CURVE (libsodium); link tests drop packets with nftables
+  libzmq3-dev cppzmq-dev libsodium-dev nftables
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)

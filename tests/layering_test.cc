@@ -45,8 +45,10 @@ const std::vector<Part>& Parts() {
       {"daemon/telemetry/", {"mapping/", "stereo/", "estimation/", "hal/", "io/", "common/"}},
       {"daemon/pipeline/",
        {"daemon/telemetry/", "detection/", "fpga/", "mapping/", "stereo/", "estimation/", "hal/", "io/", "common/"}},
+      {"daemon/comms/",
+       {"daemon/pipeline/", "daemon/telemetry/", "mapping/", "estimation/", "hal/", "io/", "common/"}},
       {"daemon/",
-       {"daemon/pipeline/", "daemon/telemetry/", "sim/", "drivers/", "detection/", "fpga/", "mapping/", "stereo/",
+       {"daemon/comms/", "daemon/pipeline/", "daemon/telemetry/", "sim/", "drivers/", "detection/", "fpga/", "mapping/", "stereo/",
         "estimation/", "hal/", "io/", "common/"}},
       // `cairn bench` runs the scenes the tests use, so the tools may include testing/ helpers.
       {"tools/",

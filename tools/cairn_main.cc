@@ -35,6 +35,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"config doc", "print every configuration key with its unit, range and default", RunConfigDoc},
     {"summary", "a short account of cairnd output folders (from their summary.json)", RunSummary},
     {"mcap info", "summarize MCAP recordings (also ones cut short by a crash)", RunMcapInfo},
+    {"keys generate", "a robot's CURVE key pair for the team exchange (<name>.key 0600, <name>.pub)", RunKeysGenerate},
     {"trajectory convert", "convert trajectories between TUM, EuRoC CSV and KITTI", RunTrajectoryConvert},
     {"stereo", "dense disparity of a stereo pair (SGM), written as PFM", RunStereo},
     {"stereo-eval", "score a disparity PFM against Middlebury/KITTI ground truth (JSON)", RunStereoEval},

@@ -20,6 +20,7 @@ int RunConfigDoc(const CommandArgs& args);
 int RunMcapInfo(const CommandArgs& args);
 int RunSummary(const CommandArgs& args);
 int RunTrajectoryConvert(const CommandArgs& args);
+int RunKeysGenerate(const CommandArgs& args);
 
 }  // namespace cairn::tools
 

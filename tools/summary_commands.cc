@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include <filesystem>
 #include <optional>
@@ -12,6 +13,7 @@
 #include "common/json_value.h"
 #include "daemon/simulated_map_accuracy.h"
 #include "estimation/eval/trajectory.h"
+#include "estimation/eval/team_evaluator.h"
 #include "estimation/eval/trajectory_evaluator.h"
 #include "tools/commands.h"
 
@@ -63,6 +65,56 @@ void PrintMapAccuracy(const std::string& dir, const Eigen::Isometry3d& T_world_m
   } else {
     std::printf("  map vs world: %lld occupied voxels, %.1f %% within one voxel (%.2f m) of a true surface\n",
                 static_cast<long long>(a->occupied), 100.0 * a->fraction(), a->voxel);
+  }
+}
+
+// team.json: the exchange per peer, and every robot's global trajectory as this robot's graph places
+// it, scored with one alignment for the team against the ground truth in each robot's sibling
+// output folder (the demo's out/<robot>/).
+void PrintTeam(const std::string& dir) {
+  const std::string path = dir + "/team.json";
+  if (!std::filesystem::exists(path)) return;
+  const JsonValue t = JsonValue::ParseFile(path);
+  std::printf("  team: %s, exchange %.0f s%s\n", t["settled"].boolean() ? "settled" : "NOT settled",
+              t["seconds"].number(), t["settled"].boolean() ? " (every teammate holds the same logs)" : "");
+  for (const JsonValue& p : t["peers"].array()) {
+    std::printf("    link to %s: sent %.1f KB (%.2f KB/s), received %.1f KB (%.2f KB/s), items %.0f out / %.0f in, "
+                "%.0f duplicates, %.0f resends, %.0f queued\n",
+                p["name"].string().c_str(), p["sent_bytes"].number() / 1e3, p["sent_bytes_per_s"].number() / 1e3,
+                p["received_bytes"].number() / 1e3, p["received_bytes_per_s"].number() / 1e3,
+                p["items_sent"].number(), p["items_received"].number(), p["duplicates"].number(),
+                p["resends"].number(), p["queued_items"].number());
+  }
+  std::vector<TeamTrajectory> team;
+  std::string not_connected;
+  const std::filesystem::path parent = std::filesystem::path(dir).parent_path();
+  for (const JsonValue& r : t["robots"].array()) {
+    const std::string name = r["name"].string();
+    std::string items;
+    for (const auto& [kind, n] : r["items"].object()) items += (items.empty() ? "" : ", ") + std::to_string(static_cast<long long>(n.number())) + " " + kind;
+    std::printf("    robot %s (%s): %s; %s\n", name.c_str(), r["letter"].string().c_str(),
+                r["connected"].boolean() ? "connected" : "not connected", items.empty() ? "no items" : items.c_str());
+    if (!r["connected"].boolean()) {
+      not_connected += " " + name;
+      continue;
+    }
+    const std::string est = dir + "/global_trajectory_" + name + ".tum";
+    const std::string gt = (parent / name / "ground_truth.tum").string();
+    if (!std::filesystem::exists(est) || !std::filesystem::exists(gt)) continue;
+    auto e = TrajectoryIo::Read(est, TrajectoryFormat::kTum);
+    auto g = TrajectoryIo::Read(gt, TrajectoryFormat::kTum);
+    if (e.ok() && g.ok()) team.push_back(TeamTrajectory{name, *g, *e});
+  }
+  if (team.empty()) return;
+  auto r = EvaluateTeam(team, TrajectoryEvalOptions{});
+  if (!r.ok()) {
+    std::printf("    team accuracy: %s\n", r.status().message().c_str());
+    return;
+  }
+  for (const auto& [name, e] : r->robots) {
+    std::printf("    team accuracy (one alignment for %zu robots): %s %.2f m path, ATE RMSE %.3f m (%.2f %% of the path)\n",
+                team.size(), name.c_str(), e.path_length, e.ate_rmse,
+                e.path_length > 0.0 ? 100.0 * e.ate_rmse / e.path_length : 0.0);
   }
 }
 
@@ -129,6 +181,7 @@ int RunSummary(const CommandArgs& args) {
       if (std::filesystem::exists(std::string(dir) + "/global_trajectory.tum"))
         PrintAccuracy(dir, "global_trajectory.tum", "global (graph) vs ground truth");
       if (T_world_est && s["mode"].string() == "sim") PrintMapAccuracy(dir, *T_world_est);
+      PrintTeam(dir);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());
       rc = 1;

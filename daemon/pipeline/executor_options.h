@@ -47,6 +47,8 @@ struct ExecutorsOptions {
   ExecutorOptions graph_full_solve;
   // The submap matcher pool's workers (matching.workers of them), the lowest priority.
   ExecutorOptions matcher;
+  // The team exchange: the item store, ZeroMQ sockets and submap encoding (team.enabled).
+  ExecutorOptions comms;
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
@@ -57,6 +59,7 @@ struct ExecutorsOptions {
     v.Section("graph", graph);
     v.Section("graph_full_solve", graph_full_solve);
     v.Section("matcher", matcher);
+    v.Section("comms", comms);
   }
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "common/monotonic_clock.h"
 
@@ -93,6 +94,7 @@ void GraphStage::OnInput(const GraphInput& input) {
 }
 
 void GraphStage::OnEstimate(const FrameEstimate& e) {
+  last_estimate_is_pose_ = false;
   if (!e.valid) return;
   ++report_.estimates;
   if (!started_) {
@@ -118,6 +120,8 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
   v.z = ToPose3(e.T_frame_body);
   v.information = Floored(e.pose_covariance).inverse();
   if (!Add(v)) return;
+  last_estimate_is_pose_ = true;
+  last_pose_index_ = IndexOfVariable(v.b);
   ++report_.robot_poses;
   Update();
 }
@@ -136,9 +140,7 @@ void GraphStage::OnFrameSwitch(const FrameSwitchEvent& e) {
   w.a = OriginKey(e.old_frame_id);
   w.b = OriginKey(e.new_frame_id);
   w.z = ToPose3(e.transform.T_old_new);
-  // The filter states the new origin's position error in the old frame.
-  w.information =
-      Floored(TranslationInSecondFrame(e.transform.covariance, e.transform.T_old_new.linear())).inverse();
+  w.information = SwitchInformation(e.transform.covariance, e.transform.T_old_new);
   if (!Add(w)) {
     ++report_.unplaced;  // the new frame stays unknown: its estimates are counted as unplaced
     return;
@@ -159,9 +161,16 @@ void GraphStage::Finish() {
 
 Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTransform& T_a_b,
                             const Eigen::Matrix4d& covariance, double tilt_sigma) {
-  if (!graph_.HasVariable(OriginKey(frame_a)) || !graph_.HasVariable(OriginKey(frame_b)))
-    return NotFoundError("match between origins " + std::to_string(frame_a) + " and " + std::to_string(frame_b) +
-                         ": not both in the graph");
+  return AddMatch(robot_, frame_a, robot_, frame_b, T_a_b, covariance, tilt_sigma);
+}
+
+Status GraphStage::AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64_t frame_b,
+                            const FourDofTransform& T_a_b, const Eigen::Matrix4d& covariance, double tilt_sigma) {
+  const uint64_t key_a = VariableKey(VariableKind::kSubmap, robot_a, frame_a);
+  const uint64_t key_b = VariableKey(VariableKind::kSubmap, robot_b, frame_b);
+  if (!graph_.HasVariable(key_a) || !graph_.HasVariable(key_b))
+    return NotFoundError("match between origins " + std::string(1, robot_a) + std::to_string(frame_a) + " and " +
+                         std::string(1, robot_b) + std::to_string(frame_b) + ": not both in the graph");
   // (x, y, z, yaw) into (translation, rotation vector); yaw is the rotation about z, the same axis
   // in both gravity-aligned frames. The matcher states the translation in A's frame.
   Matrix6d c = Matrix6d::Zero();
@@ -172,8 +181,8 @@ Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTra
   c = TranslationInSecondFrame(c, T_a_b.ToIsometry().linear());
   SlamFactor f;
   f.kind = FactorKind::kMatch;
-  f.a = OriginKey(frame_a);
-  f.b = OriginKey(frame_b);
+  f.a = key_a;
+  f.b = key_b;
   f.z = ToPose3(T_a_b.ToIsometry());
   f.information = Floored(c).inverse();
   const size_t rejected = report_.rejected_factors;
@@ -181,8 +190,92 @@ Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTra
                                                ? "the graph refused the match"
                                                : report_.errors.back());
   ++report_.matches;
+  if (robot_a != robot_b) ++report_.team_matches;
   Update();
   return Status::Ok();
+}
+
+Matrix6d GraphStage::SwitchInformation(const Matrix6d& covariance, const Eigen::Isometry3d& T_old_new) const {
+  // The filter states the new origin's position error in the old frame.
+  return Floored(TranslationInSecondFrame(covariance, T_old_new.linear())).inverse();
+}
+
+void GraphStage::OnTeamInput(const TeamInput& in) {
+  ++report_.team_inputs;
+  const char r = in.letter;
+  if (r == 0 || r == robot_) return;  // the exchange hands this robot's own items back never
+  switch (in.kind) {
+    case TeamInput::Kind::kFrameSwitch: {
+      SlamFactor w;
+      w.kind = FactorKind::kFrameSwitch;
+      w.a = VariableKey(VariableKind::kSubmap, r, in.old_frame);
+      w.b = VariableKey(VariableKind::kSubmap, r, in.new_frame);
+      w.z = ToPose3(in.T_old_new);
+      w.information = SwitchInformation(in.switch_covariance, in.T_old_new);
+      if (Add(w)) ++report_.team_factors;
+      break;
+    }
+    case TeamInput::Kind::kPoses: {
+      auto& placed = team_estimates_[r];
+      for (const TeamPose& p : in.poses) placed.push_back(Placed{p.time, p.frame, p.T_frame_body});
+      for (const TeamGraphPose& g : in.graph_poses) {
+        SlamFactor v;
+        v.kind = FactorKind::kFilterEstimate;
+        v.a = VariableKey(VariableKind::kSubmap, r, g.pose.frame);
+        v.b = VariableKey(VariableKind::kRobotPose, r, g.pose_index);
+        v.z = ToPose3(g.pose.T_frame_body);
+        v.information = Floored(g.covariance).inverse();
+        if (Add(v)) ++report_.team_factors;
+      }
+      break;
+    }
+    case TeamInput::Kind::kMatch: {
+      if (in.match.letter_a == 0 || in.match.letter_b == 0) break;  // a robot not in the team file
+      pending_matches_.push_back(PendingMatch{in.match.letter_a, in.match.letter_b, in.match.frame_a, in.match.frame_b,
+                                              in.match.T_a_b, in.match.covariance, in.match.tilt_sigma});
+      break;
+    }
+    default:
+      break;
+  }
+  RetryPendingMatches();
+  Update();
+}
+
+void GraphStage::RetryPendingMatches() {
+  for (size_t i = 0; i < pending_matches_.size();) {
+    const PendingMatch& m = pending_matches_[i];
+    const Status s = AddMatch(m.robot_a, m.frame_a, m.robot_b, m.frame_b, m.T_a_b, m.covariance, m.tilt_sigma);
+    if (s.code() == StatusCode::kNotFound) {
+      ++i;
+      continue;
+    }
+    if (s.ok()) ++report_.team_factors;
+    pending_matches_.erase(pending_matches_.begin() + static_cast<long>(i));
+  }
+  report_.team_matches_pending = pending_matches_.size();
+}
+
+std::vector<char> GraphStage::Robots() const {
+  std::vector<char> out{robot_};
+  std::set<char> seen{robot_};
+  for (uint64_t key : graph_.VariableKeys()) {
+    if (seen.insert(RobotOfVariable(key)).second) out.push_back(RobotOfVariable(key));
+  }
+  return out;
+}
+
+bool GraphStage::Connected(char robot) const {
+  if (robot == robot_) return true;
+  const std::vector<uint64_t> unconnected = graph_.Unconnected();
+  const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
+  bool any = false;
+  for (uint64_t key : graph_.VariableKeys()) {
+    if (RobotOfVariable(key) != robot || KindOfKey(key) != VariableKind::kSubmap) continue;
+    if (loose.count(key) != 0) return false;
+    any = true;
+  }
+  return any;
 }
 
 std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
@@ -190,10 +283,11 @@ std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
   std::vector<uint64_t> keys;
   const std::vector<uint64_t> unconnected = graph_.Unconnected();
   for (uint64_t key : graph_.VariableKeys()) {
-    if (KindOfKey(key) != VariableKind::kSubmap || RobotOfVariable(key) != robot_) continue;
+    if (KindOfKey(key) != VariableKind::kSubmap) continue;
     const auto p = graph_.Pose(key);
     if (!p.ok()) continue;
     OriginEstimate o;
+    o.robot = RobotOfVariable(key);
     o.frame_id = IndexOfVariable(key);
     const Eigen::Matrix3d R = p->R();
     o.T_global_origin = FourDofTransform(p->t, std::atan2(R(1, 0), R(0, 0)));
@@ -219,21 +313,32 @@ std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
 
 GraphStageReport GraphStage::report() const { return report_; }
 
-std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins() const {
+std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins() const { return FrameOrigins(robot_); }
+
+std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins(char robot) const {
   std::map<uint64_t, Eigen::Isometry3d> out;
   for (uint64_t key : graph_.VariableKeys()) {
-    if (KindOfKey(key) != VariableKind::kSubmap || RobotOfVariable(key) != robot_) continue;
+    if (KindOfKey(key) != VariableKind::kSubmap || RobotOfVariable(key) != robot) continue;
     if (auto p = graph_.Pose(key); p.ok()) out[IndexOfVariable(key)] = ToIsometry(*p);
   }
   return out;
 }
 
-Trajectory GraphStage::GlobalTrajectory() const {
+Trajectory GraphStage::GlobalTrajectory() const { return GlobalTrajectory(robot_); }
+
+Trajectory GraphStage::GlobalTrajectory(char robot) const {
   Trajectory t;
   t.frame = "global";
-  const auto origins = FrameOrigins();
-  t.poses.reserve(estimates_.size());
-  for (const Placed& e : estimates_) {
+  if (!Connected(robot)) return t;
+  const auto origins = FrameOrigins(robot);
+  const std::vector<Placed>* placed = &estimates_;
+  if (robot != robot_) {
+    const auto it = team_estimates_.find(robot);
+    if (it == team_estimates_.end()) return t;
+    placed = &it->second;
+  }
+  t.poses.reserve(placed->size());
+  for (const Placed& e : *placed) {
     const auto origin = origins.find(e.frame_id);
     if (origin == origins.end()) continue;
     t.poses.push_back(StampedPose{e.time, origin->second * e.T_frame_body});

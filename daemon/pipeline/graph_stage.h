@@ -17,6 +17,7 @@
 #include "daemon/pipeline/estimation_stage.h"
 #include "daemon/pipeline/graph_stage_options.h"
 #include "daemon/pipeline/latency_histogram.h"
+#include "daemon/pipeline/team_input.h"
 #include "daemon/telemetry/graph_scene.h"
 #include "estimation/eval/trajectory.h"
 #include "estimation/graph/pose_graph.h"
@@ -35,6 +36,10 @@ struct GraphStageReport {
   uint64_t reinitializations = 0;
   uint64_t rejected_factors = 0;
   uint64_t matches = 0;          // submap matches added as c factors
+  uint64_t team_matches = 0;     // of them, between two robots
+  uint64_t team_inputs = 0;      // teammates' items taken
+  uint64_t team_factors = 0;     // teammates' w, v and c factors added
+  uint64_t team_matches_pending = 0;  // waiting for an origin not in the graph yet
   // Estimates or switches the graph could not place: their frame is not connected to the chain
   // (an input was lost upstream). Counted, never guessed.
   uint64_t unplaced = 0;
@@ -46,6 +51,7 @@ struct GraphStageReport {
 
 // One of the robot's submap origins as the graph places it now.
 struct OriginEstimate {
+  char robot = 0;  // graph letter
   uint64_t frame_id = 0;
   FourDofTransform T_global_origin;  // roll and pitch dropped (origins are gravity aligned)
   Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();  // (x, y, z, yaw), global axes
@@ -62,7 +68,23 @@ class GraphStage {
   // Cauchy loss; the graph re-optimizes. An error says why the graph refused it.
   Status AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTransform& T_a_b,
                   const Eigen::Matrix4d& covariance, double tilt_sigma);
-  // The robot's origins with, when `covariances`, their marginal covariances (a covariance solve).
+  // The same between origins of any robots of the team, by graph letter.
+  Status AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64_t frame_b, const FourDofTransform& T_a_b,
+                  const Eigen::Matrix4d& covariance, double tilt_sigma);
+  // A teammate's item: its frame switches w and poses v join the graph under its letter (a
+  // floating subgraph until a match or detection ties it to this robot's), its estimates make its
+  // global trajectory, and matches it made are added (once both origins are known).
+  void OnTeamInput(const TeamInput& input);
+  // Every robot with variables in the graph, this one first.
+  std::vector<char> Robots() const;
+  // Whether `robot`'s origins are tied to this robot's prior (always for this robot).
+  bool Connected(char robot) const;
+  // T_global_frame of every origin of `robot` the graph holds.
+  std::map<uint64_t, Eigen::Isometry3d> FrameOrigins(char robot) const;
+  // `robot`'s estimates placed by its origins; empty when it is not connected (never guessed).
+  Trajectory GlobalTrajectory(char robot) const;
+  // The origins of every robot in the graph with, when `covariances`, their marginal covariances
+  // (a covariance solve).
   std::vector<OriginEstimate> OriginEstimates(bool covariances);
 
   // Full solves after loop closures go through `runner` (live); without one they run inline.
@@ -76,6 +98,11 @@ class GraphStage {
   // Time of the last estimate placed, and the number of submap origins (cheap, for live updates).
   Timestamp last_time() const { return estimates_.empty() ? Timestamp() : estimates_.back().time; }
   uint64_t submap_origins() const { return report_.submap_origins; }
+  // Whether the last estimate taken became graph pose `*index` (a factor v).
+  bool last_estimate_is_pose(uint64_t* index) const {
+    *index = last_pose_index_;
+    return last_estimate_is_pose_;
+  }
   const LatencyHistogram& update_time() const { return update_time_; }
   // T_global_frame of every local frame in the graph (global = the first frame).
   std::map<uint64_t, Eigen::Isometry3d> FrameOrigins() const;
@@ -103,12 +130,25 @@ class GraphStage {
   char robot_ = 'a';
   bool started_ = false;
   uint64_t next_pose_ = 0;
+  bool last_estimate_is_pose_ = false;
+  uint64_t last_pose_index_ = 0;
   struct Placed {
     Timestamp time;
     uint64_t frame_id = 0;
     Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
   };
   std::vector<Placed> estimates_;
+  std::map<char, std::vector<Placed>> team_estimates_;
+  struct PendingMatch {
+    char robot_a, robot_b;
+    uint64_t frame_a, frame_b;
+    FourDofTransform T_a_b;
+    Eigen::Matrix4d covariance;
+    double tilt_sigma;
+  };
+  std::vector<PendingMatch> pending_matches_;
+  void RetryPendingMatches();
+  Matrix6d SwitchInformation(const Matrix6d& covariance, const Eigen::Isometry3d& T_old_new) const;
   std::map<uint64_t, Eigen::Matrix3d> origin_covariance_;  // of the live view, as last computed
   LatencyHistogram update_time_;
   GraphStageReport report_;

@@ -235,9 +235,10 @@ void MappingStage::FinishSubmaps() {
   Keep(mapper_.FinishOpenSubmap());
 }
 
-void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins) {
+void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins,
+                          const std::vector<PlacedSubmap>* team_submaps) {
   FinishSubmaps();
-  if (graph_origins != nullptr && !T_first_frame_.empty()) PlaceByGraph(*graph_origins);
+  if (graph_origins != nullptr && !T_first_frame_.empty()) PlaceByGraph(*graph_origins, team_submaps);
   composer_.Update();
   const std::vector<CloudPoint> cloud = composer_.Cloud();
   const std::unique_ptr<octomap::OcTree> tree = composer_.Octree();
@@ -255,7 +256,8 @@ void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_ori
   }
 }
 
-void MappingStage::PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins) {
+void MappingStage::PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins,
+                                const std::vector<PlacedSubmap>* team) {
   // The map's frame stays the first mapped frame; the graph places every submap relative to it.
   const auto base = origins.find(T_first_frame_.begin()->first);
   if (base == origins.end()) {
@@ -271,6 +273,16 @@ void MappingStage::PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& ori
       ++report_.submaps_placed_by_graph;
     } else if (s.code() != StatusCode::kNotFound) {
       Error(s.ToString());
+    }
+  }
+  // Teammates' submaps join the same map where the graph has placed them.
+  if (team == nullptr) return;
+  for (const PlacedSubmap& p : *team) {
+    if (Status s = composer_.SetSubmap(p.submap, T_map_global * p.T_global_submap); s.ok()) {
+      ++report_.team_submaps;
+    } else {
+      Error("teammate's submap " + p.submap->metadata().robot + "/" + std::to_string(p.submap->metadata().id) + ": " +
+            s.ToString());
     }
   }
 }

@@ -31,6 +31,12 @@
 
 namespace cairn {
 
+// A teammate's finished submap at its origin in the graph's global frame.
+struct PlacedSubmap {
+  std::shared_ptr<const Submap> submap;
+  Eigen::Isometry3d T_global_submap = Eigen::Isometry3d::Identity();
+};
+
 class TelemetryStage;
 
 struct MappingSetup {
@@ -63,6 +69,7 @@ struct MappingStageReport {
   uint64_t map_points = 0;           // composed cloud at the end
   uint64_t map_voxels = 0;           // composed occupancy voxels at the end
   uint64_t submaps_placed_by_graph = 0;  // composed at the SLAM graph's origins
+  uint64_t team_submaps = 0;            // teammates' submaps composed into the map
   LocalMapperStats mapper;
   std::vector<std::string> errors;   // the first few, verbatim
 };
@@ -86,7 +93,8 @@ class MappingStage {
   // End of the run: maps what waits, finishes the open submap and writes the map exports. With
   // `graph_origins` (T_global_frame per local frame, from the SLAM graph) the submaps are composed
   // at the graph's optimized origins instead of along the chain of frame switches.
-  void Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins = nullptr);
+  void Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_origins = nullptr,
+              const std::vector<PlacedSubmap>* team_submaps = nullptr);
   // Finished submaps and obstacle-map snapshots also go to recording and the live stream.
   void SetTelemetry(TelemetryStage* telemetry) { telemetry_ = telemetry; }
 
@@ -103,7 +111,7 @@ class MappingStage {
   void Map(const DepthImage& image, const FrameEstimate& e);
   void ApplySwitchesUpTo(uint64_t frame_id);
   void Keep(std::shared_ptr<const Submap> submap);
-  void PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins);
+  void PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins, const std::vector<PlacedSubmap>* team);
   void Error(const std::string& what);
 
   MappingSetup setup_;

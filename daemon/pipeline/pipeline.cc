@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <thread>
 
 namespace cairn {
@@ -101,6 +102,17 @@ Status Pipeline::EnableMatching(const SubmapMatchingOptions& options, const std:
   return Status::Ok();
 }
 
+Status Pipeline::SetTeamLink(TeamLink* team, std::map<char, std::string> names) {
+  if (started_) return FailedPreconditionError("SetTeamLink() after Start()");
+  if (!graph_) return FailedPreconditionError("the team exchange needs the graph enabled");
+  team_ = team;
+  if (matching_) matching_->SetTeam(std::move(names), team);
+  team_->SetNotify([this] { graph_signal_.Notify(); });
+  // Finished submaps travel to the team even without the matcher.
+  if (mapping_) mapping_->PublishSubmapsTo(&submap_queue_);
+  return Status::Ok();
+}
+
 void Pipeline::SetTelemetry(TelemetryStage* telemetry) {
   telemetry_ = telemetry;
   if (mapping_) mapping_->SetTelemetry(telemetry);
@@ -160,6 +172,18 @@ void Pipeline::StopAndDrain() {
     graph_exec_.RequestStop();
     graph_signal_.Notify();
     graph_exec_.Join();
+    if (team_) {
+      // The last own items go out; teammates' keep coming until the team holds the same logs
+      // (or the linger time is over). This thread owns the graph now.
+      TakeSubmaps(UINT64_MAX);
+      team_->FinishOwnLog();
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(team_->linger_seconds());
+      while (!team_->Settled() && std::chrono::steady_clock::now() < deadline) {
+        if (!TakeTeamInputs()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (matching_) matching_->Step(*graph_);
+      }
+      TakeTeamInputs();
+    }
     if (matching_) {
       TakeSubmaps(UINT64_MAX);
       matching_->Drain(*graph_);
@@ -173,7 +197,17 @@ void Pipeline::StopAndDrain() {
     TakeMappingInputs();
     if (graph_) {
       const auto origins = graph_->FrameOrigins();
-      mapping_->Finish(&origins);
+      // Teammates' submaps whose robots the graph has tied to this one's frame.
+      std::vector<PlacedSubmap> team;
+      for (const auto& [letter, submaps] : team_submaps_) {
+        if (!graph_->Connected(letter)) continue;
+        const auto team_origins = graph_->FrameOrigins(letter);
+        for (const auto& [frame, submap] : submaps) {
+          const auto o = team_origins.find(frame);
+          if (o != team_origins.end()) team.push_back(PlacedSubmap{submap, o->second});
+        }
+      }
+      mapping_->Finish(&origins, &team);
     } else {
       mapping_->Finish();
     }
@@ -395,9 +429,38 @@ void Pipeline::TakeMappingInputs() {
 void Pipeline::TakeSubmaps(uint64_t max_id) {
   while (const std::shared_ptr<const Submap>* s = submap_queue_.Front()) {
     if ((*s)->metadata().id > max_id) return;
-    matching_->OnSubmap(*s);
+    if (matching_) matching_->OnSubmap(*s);
+    if (team_) team_->PublishSubmap(*s);
     submap_queue_.PopFront();
   }
+}
+
+void Pipeline::PublishToTeam(const GraphInput& input) {
+  if (input.kind == GraphInput::Kind::kFrameSwitch) {
+    team_->PublishFrameSwitch(input.frame_switch);
+    return;
+  }
+  if (!input.estimate.valid) return;
+  uint64_t index = 0;
+  const bool pose = graph_->last_estimate_is_pose(&index);
+  team_->PublishEstimate(input.estimate, pose, index);
+}
+
+bool Pipeline::TakeTeamInputs() {
+  bool any = false;
+  TeamInput in;
+  while (team_->NextInput(&in)) {
+    any = true;
+    if (in.kind == TeamInput::Kind::kSubmap && in.submap) {
+      team_submaps_[in.letter][in.new_frame] = in.submap;
+      if (matching_) matching_->OnTeamSubmap(in.robot, in.new_frame, in.submap);
+    }
+    if (matching_ && (in.kind == TeamInput::Kind::kAttempt || in.kind == TeamInput::Kind::kMatch)) {
+      matching_->OnTeamAttempt(in.match, in.kind == TeamInput::Kind::kMatch || in.matched);
+    }
+    graph_->OnTeamInput(in);
+  }
+  return any;
 }
 
 void Pipeline::MappingLoop(std::stop_token stop) {
@@ -439,6 +502,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
     bool worked = false;
     while (const GraphInput* in = graph_queue_.Front()) {
       graph_->OnInput(*in);
+      if (team_) PublishToTeam(*in);
       // Submap k is finished before mapping asks to leave frame k + 1, so once the switch into
       // frame n is in, every submap up to n - 2 is in the queue: a fixed point of the data flow.
       const bool into_frame = in->kind == GraphInput::Kind::kFrameSwitch;
@@ -453,6 +517,10 @@ void Pipeline::GraphLoop(std::stop_token stop) {
     if (matching_ && !deterministic_) {
       TakeSubmaps(UINT64_MAX);
       matching_->Step(*graph_);
+    }
+    if (team_) {
+      if (!matching_) TakeSubmaps(UINT64_MAX);
+      worked |= TakeTeamInputs();
     }
     // The live view: at each new origin, else about once a second of data.
     const bool new_origin = graph_->submap_origins() != graph_shown_origins_;

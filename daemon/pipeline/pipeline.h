@@ -24,6 +24,7 @@
 #include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
 #include "daemon/pipeline/submap_matching_stage.h"
+#include "daemon/pipeline/team_link.h"
 #include "daemon/pipeline/telemetry_stage.h"
 #include "daemon/pipeline/vo_stage.h"
 #include "daemon/telemetry/graph_scene_encoder.h"
@@ -110,6 +111,11 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   // Matches finished submaps on the matcher pool and adds the matches to the graph (thesis 6.1).
   // Needs EnableMapping() and EnableGraph() first; call before Start().
   Status EnableMatching(const SubmapMatchingOptions& options, const std::string& robot);
+  // Shares this robot's frame switches, estimates, submaps and matches with the team through `team`
+  // and takes teammates' items into the graph and the matcher (graph thread). Needs EnableGraph()
+  // first; `team` must outlive the pipeline's threads. Call before Start().
+  // `names`: every robot's name by graph letter.
+  Status SetTeamLink(TeamLink* team, std::map<char, std::string> names);
   // Asks the filter to switch its frame of reference. One producer: the vo thread (the interim
   // distance/sigma policy) or, with mapping enabled, the mapping thread through the
   // FrameSwitchRequesterInterface below.
@@ -152,6 +158,10 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   }
   // Valid after StopAndDrain(); null when the graph is not enabled.
   const GraphStage* graph() const { return graph_.get(); }
+  // Teammates' finished submaps received, by graph letter and frame (valid after StopAndDrain()).
+  const std::map<char, std::map<uint64_t, std::shared_ptr<const Submap>>>& team_submaps() const {
+    return team_submaps_;
+  }
   // Valid after StopAndDrain(); null when matching is not enabled.
   const SubmapMatchingStage* matching() const { return matching_.get(); }
   FaultReport fault_report() const;
@@ -173,8 +183,11 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void GraphLoop(std::stop_token stop);
   void DrainEstimates();
   void TakeMappingInputs();
-  // Graph thread: finished submaps up to `max_id` into the matching stage.
+  // Graph thread: finished submaps up to `max_id` into the matching stage and to the team.
   void TakeSubmaps(uint64_t max_id);
+  // Graph thread (or the stopping thread once it is joined): teammates' items into the graph.
+  bool TakeTeamInputs();
+  void PublishToTeam(const GraphInput& input);
 
   const bool deterministic_;
   WorkSignal estimation_signal_;
@@ -248,6 +261,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   std::atomic<bool> filter_running_{false};
 
   TelemetryStage* telemetry_ = nullptr;
+  TeamLink* team_ = nullptr;
+  std::map<char, std::map<uint64_t, std::shared_ptr<const Submap>>> team_submaps_;  // graph thread
   mutable std::mutex fault_mutex_;
   FaultReport faults_;
   bool started_ = false;

@@ -65,7 +65,7 @@ SubmapMatchingStage::Done SubmapMatchingStage::Run(const Job& job) const {
   if (job.features) {
     done.features = std::make_shared<const SubmapFeatures>(extractor_.Extract(*job.submap));
   } else {
-    done.match = matcher_.Match(*job.a, *job.b, job.pair.prior);
+    done.match = job.pair.has_prior ? matcher_.Match(*job.a, *job.b, job.pair.prior) : matcher_.Match(*job.a, *job.b);
   }
   return done;
 }
@@ -108,24 +108,66 @@ void SubmapMatchingStage::Submit(Job job) {
 
 void SubmapMatchingStage::OnSubmap(std::shared_ptr<const Submap> submap) {
   if (submap == nullptr) return;
+  const uint64_t id = submap->metadata().id;
+  OnTeamSubmap(robot_, id, std::move(submap));
+}
+
+void SubmapMatchingStage::OnTeamSubmap(const std::string& robot, uint64_t frame, std::shared_ptr<const Submap> submap) {
+  if (submap == nullptr) return;
   ++report_.submaps;
+  if (robot != robot_) ++report_.team_submaps;
   Job job;
   job.features = true;
   job.submap = std::move(submap);
+  job.key = SubmapKey{robot, frame};
   Submit(std::move(job));
+}
+
+std::string SubmapMatchingStage::PairOwner(const SubmapKey& a, const SubmapKey& b) {
+  if (a.robot == b.robot) return a.robot;
+  // FNV-1a of the ordered pair: the same answer on every robot, and about half the pairs each.
+  const auto& [first, second] = a < b ? std::pair(a, b) : std::pair(b, a);
+  uint64_t h = 1469598103934665603ull;
+  for (const std::string& part : {first.robot, std::to_string(first.id), second.robot, std::to_string(second.id)}) {
+    for (unsigned char c : part) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;
+  }
+  return (h >> 17) % 2 == 0 ? first.robot : second.robot;
+}
+
+void SubmapMatchingStage::SetTeam(std::map<char, std::string> names, TeamLink* team) {
+  names_ = std::move(names);
+  for (const auto& [letter, name] : names_) letters_[name] = letter;
+  team_ = team;
+  pairing_.SetOwnership([robot = robot_](const SubmapKey& a, const SubmapKey& b) { return PairOwner(a, b) == robot; });
+}
+
+void SubmapMatchingStage::OnTeamAttempt(const TeamMatch& pair, bool matched) {
+  const SubmapKey a{pair.robot_a, pair.frame_a}, b{pair.robot_b, pair.frame_b};
+  if (pairing_.Attempted(a, b) && pairing_.Outcome(a, b).has_value()) return;
+  pairing_.MarkAttempted(a, b, matched ? MatchStatus::kMatched : MatchStatus::kNoMatch);
+  ++report_.team_attempts;
 }
 
 void SubmapMatchingStage::RefreshEstimates(GraphStage& graph) {
   const std::vector<OriginEstimate> origins = graph.OriginEstimates(/*covariances=*/true);
   for (const OriginEstimate& o : origins) {
-    const auto f = features_.find(SubmapKey{robot_, o.frame_id});
+    std::string robot = robot_;
+    if (o.robot != graph.robot()) {
+      const auto name = names_.find(o.robot);
+      if (name == names_.end()) continue;
+      robot = name->second;
+    }
+    const auto f = features_.find(SubmapKey{robot, o.frame_id});
     if (f == features_.end()) continue;
     PairingSubmap p;
     p.key = f->first;
     p.suitable = f->second->suitable();
     p.obstacle_box_xy = f->second->obstacle_box_xy;
     p.placed = o.has_covariance;
-    p.component = o.connected ? 0 : 1;
+    // Robots not tied to this one each float on their own (two of them may be tied to each other;
+    // the pairing then tries a global search where a prior would do, never the reverse).
+    p.component = o.connected ? 0 : 1 + static_cast<unsigned char>(o.robot);
     p.T_world_submap = o.T_global_origin;
     p.covariance = o.covariance;
     pairing_.Update(p);
@@ -139,7 +181,7 @@ void SubmapMatchingStage::Take(Done done, GraphStage& graph) {
     const SubmapFeatures& f = *done.features;
     features_time_.Record(Duration::Seconds((f.keypoint_ms + f.descriptor_ms) * 1e-3));
     if (f.suitable()) ++report_.suitable;
-    features_[SubmapKey{robot_, done.job.submap->metadata().id}] = done.features;
+    features_[done.job.key] = done.features;
     estimates_stale_ = true;
     return;
   }
@@ -150,8 +192,10 @@ void SubmapMatchingStage::Take(Done done, GraphStage& graph) {
   pairing_.MarkAttempted(pair.a, pair.b, attempt.result.status);
   if (attempt.result.matched()) {
     ++report_.matched;
-    const Status s = graph.AddMatch(pair.a.id, pair.b.id, attempt.result.T_a_b, attempt.result.covariance,
-                                    options_.tilt_sigma);
+    const char letter_a = pair.a.robot == robot_ ? graph.robot() : letters_.count(pair.a.robot) ? letters_.at(pair.a.robot) : 0;
+    const char letter_b = pair.b.robot == robot_ ? graph.robot() : letters_.count(pair.b.robot) ? letters_.at(pair.b.robot) : 0;
+    const Status s = graph.AddMatch(letter_a, pair.a.id, letter_b, pair.b.id, attempt.result.T_a_b,
+                                    attempt.result.covariance, options_.tilt_sigma);
     attempt.accepted = s.ok();
     attempt.verdict = s.ok() ? "added" : s.ToString();
     if (s.ok()) {
@@ -162,6 +206,20 @@ void SubmapMatchingStage::Take(Done done, GraphStage& graph) {
     }
   } else {
     attempt.verdict = "not matched";
+  }
+  if (team_ != nullptr) {
+    TeamMatch m;
+    m.robot_a = pair.a.robot;
+    m.frame_a = pair.a.id;
+    m.robot_b = pair.b.robot;
+    m.frame_b = pair.b.id;
+    if (attempt.accepted) {
+      m.T_a_b = attempt.result.T_a_b;
+      m.covariance = attempt.result.covariance;
+      m.tilt_sigma = options_.tilt_sigma;
+      team_->PublishMatch(m);
+    }
+    team_->PublishAttempt(m, attempt.result.matched(), attempt.verdict);
   }
   attempts_.push_back(std::move(attempt));
 }

@@ -21,6 +21,7 @@
 
 #include "daemon/pipeline/executor.h"
 #include "daemon/pipeline/graph_stage.h"
+#include "daemon/pipeline/team_link.h"
 #include "daemon/pipeline/latency_histogram.h"
 #include "daemon/pipeline/submap_matching_options.h"
 #include "mapping/matching/submap_feature_extractor.h"
@@ -43,6 +44,8 @@ struct SubmapMatchingReport {
   uint64_t attempts = 0;
   uint64_t matched = 0;
   uint64_t accepted = 0;   // factors the graph took
+  uint64_t team_submaps = 0;   // of `submaps`, teammates'
+  uint64_t team_attempts = 0;  // pairs teammates tried (not tried here)
   uint64_t jobs_waiting_max = 0;  // high water of the pool's queue
   double features_ms_p50 = 0.0, features_ms_max = 0.0;
   double match_ms_p50 = 0.0, match_ms_max = 0.0;
@@ -65,6 +68,16 @@ class SubmapMatchingStage {
 
   // Graph thread: a finished submap of this robot.
   void OnSubmap(std::shared_ptr<const Submap> submap);
+  // Team mode: robots' names by graph letter, and where this robot's attempts and matches go.
+  // Pairs of two robots are tried by one of them only (decided from the pair, so every robot
+  // agrees without talking); teammates' attempts are never repeated.
+  void SetTeam(std::map<char, std::string> names, TeamLink* team);
+  // Graph thread: a teammate's finished submap (its origin's frame index in the graph).
+  void OnTeamSubmap(const std::string& robot, uint64_t frame, std::shared_ptr<const Submap> submap);
+  // Graph thread: a pair a teammate tried.
+  void OnTeamAttempt(const TeamMatch& pair, bool matched);
+  // Which robot of the team tries the pair (a robot's own pairs: itself).
+  static std::string PairOwner(const SubmapKey& a, const SubmapKey& b);
   // Graph thread: takes the pool's results into the graph and hands out new pairs.
   void Step(GraphStage& graph);
   // End of the run (graph thread stopped): every pair matched, the pool stopped.
@@ -80,6 +93,7 @@ class SubmapMatchingStage {
   struct Job {
     bool features = false;  // else a match
     std::shared_ptr<const Submap> submap;
+    SubmapKey key;          // of `submap`
     SubmapPair pair;
     std::shared_ptr<const SubmapFeatures> a, b;
   };
@@ -98,6 +112,9 @@ class SubmapMatchingStage {
 
   SubmapMatchingOptions options_;
   std::string robot_;
+  std::map<char, std::string> names_;   // team mode: graph letter -> robot name
+  std::map<std::string, char> letters_;
+  TeamLink* team_ = nullptr;
   bool deterministic_;
   std::function<void()> notify_;
   SubmapFeatureExtractor extractor_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cairn {
 namespace {
@@ -37,6 +38,8 @@ std::string_view PairSkipName(PairSkip skip) {
       return "relative pose known better than the matcher measures";
     case PairSkip::kAttempted:
       return "attempted already";
+    case PairSkip::kTeammate:
+      return "a teammate's to try";
   }
   return "?";
 }
@@ -53,8 +56,22 @@ void SubmapPairing::Update(const PairingSubmap& submap) { submaps_[submap.key] =
 
 PairSkip SubmapPairing::EvaluateOrdered(const PairingSubmap& a, const PairingSubmap& b, SubmapPair* pair) const {
   if (!a.suitable || !b.suitable) return PairSkip::kUnsuitable;
+  if (owned_ && !owned_(a.key, b.key)) return PairSkip::kTeammate;
+  // A match ties graph variables: both submaps' frames must be in the graph.
   if (!a.placed || !b.placed) return PairSkip::kNotPlaced;
-  if (a.component != b.component) return PairSkip::kOtherComponent;
+  if (a.component != b.component) {
+    if (!options_.match_unconnected) return PairSkip::kOtherComponent;
+    // Nothing ties the two origins: a global search, after every pair the graph can predict.
+    if (pair != nullptr) {
+      pair->a = a.key;
+      pair->b = b.key;
+      pair->overlap_area = 0.0;
+      pair->relative_sigma = Eigen::Vector4d::Constant(std::numeric_limits<double>::infinity());
+      pair->score = -1.0;
+      pair->has_prior = false;
+    }
+    return PairSkip::kNone;
+  }
   if (options_.skip_consecutive && a.key.robot == b.key.robot &&
       (a.key.id + 1 == b.key.id || b.key.id + 1 == a.key.id))
     return PairSkip::kConsecutive;

@@ -18,6 +18,7 @@
 // teammate reports), so no pair is tried twice and the exchange can tell which robot tried it.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -40,6 +41,10 @@ struct SubmapPairingOptions {
   double matcher_precision = 0.0;  // m; eq. 6.3's right-hand side (StereoPrecision); 0: no pair skipped
   double min_relative_sigma = 0.0;  // m; floor of dsigma_t (rad for yaw)
   bool skip_consecutive = true;
+  // Pairs whose origins the graph has not tied together (a teammate not yet connected) are tried
+  // too, after every other candidate, without a prior: the only way two robots that never met
+  // find each other's places.
+  bool match_unconnected = false;
 
   void Visit(OptionsVisitor& v) {
     v.Number("min_overlap_area", min_overlap_area, 0.0, 1e6, "m^2");
@@ -48,6 +53,7 @@ struct SubmapPairingOptions {
     v.Number("matcher_precision", matcher_precision, 0.0, 100.0, "m");
     v.Number("min_relative_sigma", min_relative_sigma, 0.0, 100.0, "m");
     v.Flag("skip_consecutive", skip_consecutive);
+    v.Flag("match_unconnected", match_unconnected);
   }
 };
 
@@ -76,9 +82,12 @@ struct SubmapPair {
   Eigen::Vector4d relative_sigma = Eigen::Vector4d::Zero();  // dsigma (x, y, z, yaw), world axes
   double score = 0.0;         // eq. 6.4
   RelativePoseEstimate prior;  // T_a_b and its covariance (A's axes) for the matcher's gate
+  bool has_prior = true;       // false for origins the graph has not tied together
 };
 
-enum class PairSkip { kNone, kUnsuitable, kNotPlaced, kOtherComponent, kConsecutive, kNoOverlap, kKnownBetter, kAttempted };
+enum class PairSkip {
+  kNone, kUnsuitable, kNotPlaced, kOtherComponent, kConsecutive, kNoOverlap, kKnownBetter, kAttempted, kTeammate
+};
 std::string_view PairSkipName(PairSkip skip);
 
 class SubmapPairing {
@@ -91,6 +100,9 @@ class SubmapPairing {
 
   // A new submap or a new estimate of one.
   void Update(const PairingSubmap& submap);
+  // Only pairs for which `owned` holds are handed out (the rest are a teammate's to try); unset:
+  // every pair.
+  void SetOwnership(std::function<bool(const SubmapKey& a, const SubmapKey& b)> owned) { owned_ = std::move(owned); }
   size_t size() const { return submaps_.size(); }
 
   // Eligible pairs not yet attempted, best score first (ties by key, so the order is deterministic).
@@ -118,6 +130,7 @@ class SubmapPairing {
   std::map<SubmapKey, PairingSubmap> submaps_;
   // Outcome of each attempted pair; nullopt while the attempt runs.
   std::map<PairKey, std::optional<MatchStatus>> attempts_;
+  std::function<bool(const SubmapKey&, const SubmapKey&)> owned_;
 };
 
 }  // namespace cairn

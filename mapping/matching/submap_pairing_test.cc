@@ -103,6 +103,35 @@ TEST(SubmapPairingTest, SkipsConsecutiveUnsuitableUnplacedAndDisconnected) {
   EXPECT_EQ(census.at(PairSkip::kNone), 1u);  // a/2 - b/2
 }
 
+TEST(SubmapPairingTest, UnconnectedPairsComeLastWithoutAPriorAndOwnershipSplitsTheWork) {
+  SubmapPairingOptions options;
+  options.match_unconnected = true;
+  SubmapPairing pairing(options);
+  pairing.Update(Placed("a", 1, 0.0, 0.0, 0.0, 0.04));
+  pairing.Update(Placed("a", 3, 1.0, 0.0, 0.0, 0.09));
+  PairingSubmap teammate = Placed("b", 1, 100.0, 0.0);
+  teammate.component = 1;
+  pairing.Update(teammate);
+  PairingSubmap unplaced = Placed("b", 2, 0.0, 0.0);
+  unplaced.component = 1;
+  unplaced.placed = false;
+  pairing.Update(unplaced);
+  const std::vector<SubmapPair> candidates = pairing.Candidates();
+  ASSERT_EQ(candidates.size(), 3u);  // a/1-a/3 predicted; a/1-b/1, a/3-b/1 searched; b/2 not in the graph
+  EXPECT_TRUE(candidates[0].has_prior);
+  EXPECT_EQ(candidates[0].b.robot, "a");
+  for (size_t i = 1; i < 3; ++i) {
+    EXPECT_FALSE(candidates[i].has_prior);
+    EXPECT_EQ(candidates[i].b.robot, "b");
+    EXPECT_LT(candidates[i].score, candidates[0].score);
+  }
+  EXPECT_EQ(pairing.Evaluate({"a", 1}, {"b", 2}), PairSkip::kNotPlaced);
+  // Pairs this robot does not own are a teammate's to try.
+  pairing.SetOwnership([](const SubmapKey& a, const SubmapKey& b) { return a.robot == b.robot; });
+  EXPECT_EQ(pairing.Evaluate({"a", 1}, {"b", 1}), PairSkip::kTeammate);
+  EXPECT_EQ(pairing.Candidates().size(), 1u);
+}
+
 TEST(SubmapPairingTest, PairsKnownBetterThanTheStereoErrorAreSkipped) {
   // Eq. 6.3 for the thesis' LRU camera: f = 1080 px, b = 0.09 m, 0.5 px at 4 m.
   const double precision = SubmapPairing::StereoPrecision(0.5, 4.0, 1080.0, 0.09);

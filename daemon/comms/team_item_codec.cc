@@ -1,0 +1,279 @@
+#include "daemon/comms/team_item_codec.h"
+
+#include <cmath>
+
+#include "cairn/exchange.pb.h"
+#include "mapping/submap_codec.h"
+
+namespace cairn {
+namespace {
+
+void SetPose(exchange::RelativePose* out, const Eigen::Isometry3d& T, const Matrix6d* covariance) {
+  const Eigen::Quaterniond q(T.rotation());
+  out->set_tx(T.translation().x());
+  out->set_ty(T.translation().y());
+  out->set_tz(T.translation().z());
+  out->set_qx(q.x());
+  out->set_qy(q.y());
+  out->set_qz(q.z());
+  out->set_qw(q.w());
+  if (covariance != nullptr) {
+    for (int i = 0; i < 6; ++i)
+      for (int j = i; j < 6; ++j) out->add_covariance((*covariance)(i, j));
+  }
+}
+
+// The pose and (when `covariance`) its 21 upper-triangle covariance entries, checked.
+Status GetPose(const exchange::RelativePose& in, Eigen::Isometry3d* T, Matrix6d* covariance, const std::string& what) {
+  const double v[7] = {in.tx(), in.ty(), in.tz(), in.qx(), in.qy(), in.qz(), in.qw()};
+  for (double x : v) {
+    if (!std::isfinite(x) || std::abs(x) > 1e7) return DataLossError(what + ": a pose value is not finite or absurd");
+  }
+  Eigen::Quaterniond q(in.qw(), in.qx(), in.qy(), in.qz());
+  if (std::abs(q.norm() - 1.0) > 1e-3) return DataLossError(what + ": the rotation is not a unit quaternion");
+  *T = Eigen::Isometry3d::Identity();
+  T->linear() = q.normalized().toRotationMatrix();
+  T->translation() = Eigen::Vector3d(in.tx(), in.ty(), in.tz());
+  if (covariance == nullptr) return Status::Ok();
+  if (in.covariance_size() != 21)
+    return DataLossError(what + ": the covariance has " + std::to_string(in.covariance_size()) + " entries, not 21");
+  int k = 0;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = i; j < 6; ++j) {
+      const double c = in.covariance(k++);
+      if (!std::isfinite(c)) return DataLossError(what + ": a covariance entry is not finite");
+      (*covariance)(i, j) = (*covariance)(j, i) = c;
+    }
+  }
+  for (int i = 0; i < 6; ++i) {
+    if ((*covariance)(i, i) < 0.0) return DataLossError(what + ": a variance is negative");
+  }
+  return Status::Ok();
+}
+
+void SetPair(const TeamMatch& m, exchange::MatchAttemptItem* out) {
+  out->set_robot_a(m.robot_a);
+  out->set_incarnation_a(m.incarnation_a);
+  out->set_incarnation_b(m.incarnation_b);
+  out->set_frame_a(m.frame_a);
+  out->set_robot_b(m.robot_b);
+  out->set_frame_b(m.frame_b);
+}
+
+}  // namespace
+
+uint8_t LaneOf(TeamItemKind kind) { return kind == TeamItemKind::kSubmap ? 1 : 0; }
+
+const char* TeamItemKindName(uint16_t kind) {
+  switch (static_cast<TeamItemKind>(kind)) {
+    case TeamItemKind::kRunStart: return "run_start";
+    case TeamItemKind::kFrameSwitch: return "frame_switch";
+    case TeamItemKind::kPoseBatch: return "poses";
+    case TeamItemKind::kSubmap: return "submap";
+    case TeamItemKind::kMatch: return "match";
+    case TeamItemKind::kAttempt: return "attempt";
+  }
+  return "unknown";
+}
+
+std::string TeamItemCodec::RunStart(uint32_t incarnation, const std::string& robot_kind, Timestamp start) {
+  exchange::RunStart m;
+  m.set_incarnation(incarnation);
+  m.set_robot_kind(robot_kind);
+  m.set_start_time_ns(start.nanoseconds());
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::FrameSwitch(uint32_t incarnation, const FrameSwitchEvent& e) {
+  exchange::FrameSwitchItem m;
+  m.set_incarnation(incarnation);
+  m.set_old_frame(e.old_frame_id);
+  m.set_new_frame(e.new_frame_id);
+  m.set_time_ns(e.time.nanoseconds());
+  SetPose(m.mutable_t_old_new(), e.transform.T_old_new, &e.transform.covariance);
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::PoseBatch(uint32_t incarnation, const std::vector<OwnEstimate>& estimates) {
+  exchange::PoseBatchItem m;
+  m.set_incarnation(incarnation);
+  for (const OwnEstimate& o : estimates) {
+    const FrameEstimate& e = o.estimate;
+    auto* p = m.add_points();
+    const Eigen::Quaternionf q(e.T_frame_body.rotation().cast<float>());
+    p->set_time_ns(e.time.nanoseconds());
+    p->set_frame(e.frame_id);
+    p->set_tx(static_cast<float>(e.T_frame_body.translation().x()));
+    p->set_ty(static_cast<float>(e.T_frame_body.translation().y()));
+    p->set_tz(static_cast<float>(e.T_frame_body.translation().z()));
+    p->set_qx(q.x());
+    p->set_qy(q.y());
+    p->set_qz(q.z());
+    p->set_qw(q.w());
+    if (o.graph_pose) {
+      auto* g = m.add_graph_poses();
+      g->set_pose_index(o.pose_index);
+      g->set_frame(e.frame_id);
+      g->set_time_ns(e.time.nanoseconds());
+      SetPose(g->mutable_t_frame_body(), e.T_frame_body, &e.pose_covariance);
+    }
+  }
+  return m.SerializeAsString();
+}
+
+Expected<std::string> TeamItemCodec::Submap(uint32_t incarnation, const cairn::Submap& submap) {
+  auto bytes = SubmapCodec::Encode(submap);
+  if (!bytes.ok()) return bytes.status();
+  exchange::SubmapItem m;
+  m.set_incarnation(incarnation);
+  m.set_frame(submap.metadata().id);
+  m.set_encoded(bytes->data(), bytes->size());
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::Match(const TeamMatch& match) {
+  exchange::SubmapMatchItem m;
+  m.set_incarnation_a(match.incarnation_a);
+  m.set_incarnation_b(match.incarnation_b);
+  m.set_robot_a(match.robot_a);
+  m.set_frame_a(match.frame_a);
+  m.set_robot_b(match.robot_b);
+  m.set_frame_b(match.frame_b);
+  m.set_x(match.T_a_b.x());
+  m.set_y(match.T_a_b.y());
+  m.set_z(match.T_a_b.z());
+  m.set_yaw(match.T_a_b.yaw());
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) m.add_covariance(match.covariance(i, j));
+  m.set_tilt_sigma(match.tilt_sigma);
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::Attempt(const TeamMatch& pair, bool matched, const std::string& outcome) {
+  exchange::MatchAttemptItem m;
+  SetPair(pair, &m);
+  m.set_matched(matched);
+  m.set_outcome(outcome.substr(0, 200));
+  return m.SerializeAsString();
+}
+
+uint32_t TeamItemCodec::IncarnationOf(const StoreItem& item) {
+  exchange::RunStart m;
+  if (!m.ParseFromArray(item.payload.data(), static_cast<int>(item.payload.size()))) return 0;
+  return m.incarnation();
+}
+
+Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& names) {
+  const auto& letter_of = names.letter_of;
+  const auto index = [&](const std::string& robot, uint32_t incarnation, uint64_t frame) {
+    return names.frame_index(robot, incarnation, frame);
+  };
+  const std::string what = "item " + item.key.origin + "/" + std::to_string(item.key.lane) + "/" +
+                           std::to_string(item.key.seq) + " (" + TeamItemKindName(item.kind) + ")";
+  TeamInput in;
+  in.robot = item.key.origin;
+  in.letter = letter_of(item.key.origin);
+  const auto& bytes = item.payload;
+  const int size = static_cast<int>(bytes.size());
+  switch (static_cast<TeamItemKind>(item.kind)) {
+    case TeamItemKind::kRunStart: {
+      exchange::RunStart m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      in.kind = TeamInput::Kind::kRunStart;
+      in.time = Timestamp::FromNanoseconds(m.start_time_ns());
+      return in;
+    }
+    case TeamItemKind::kFrameSwitch: {
+      exchange::FrameSwitchItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      in.kind = TeamInput::Kind::kFrameSwitch;
+      in.old_frame = index(in.robot, m.incarnation(), m.old_frame());
+      in.new_frame = index(in.robot, m.incarnation(), m.new_frame());
+      in.time = Timestamp::FromNanoseconds(m.time_ns());
+      if (in.old_frame == in.new_frame) return DataLossError(what + ": switches frame " + std::to_string(in.old_frame) + " into itself");
+      CAIRN_RETURN_IF_ERROR(GetPose(m.t_old_new(), &in.T_old_new, &in.switch_covariance, what));
+      return in;
+    }
+    case TeamItemKind::kPoseBatch: {
+      exchange::PoseBatchItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      in.kind = TeamInput::Kind::kPoses;
+      for (const auto& p : m.points()) {
+        const float v[7] = {p.tx(), p.ty(), p.tz(), p.qx(), p.qy(), p.qz(), p.qw()};
+        bool ok = true;
+        for (float x : v) ok = ok && std::isfinite(x);
+        Eigen::Quaterniond q(p.qw(), p.qx(), p.qy(), p.qz());
+        if (!ok || std::abs(q.norm() - 1.0) > 1e-3) return DataLossError(what + ": a pose is not finite or not a rotation");
+        TeamPose pose;
+        pose.time = Timestamp::FromNanoseconds(p.time_ns());
+        pose.frame = index(in.robot, m.incarnation(), p.frame());
+        pose.T_frame_body.linear() = q.normalized().toRotationMatrix();
+        pose.T_frame_body.translation() = Eigen::Vector3d(p.tx(), p.ty(), p.tz());
+        in.poses.push_back(pose);
+      }
+      for (const auto& g : m.graph_poses()) {
+        TeamGraphPose pose;
+        pose.pose_index = g.pose_index();
+        pose.pose.frame = index(in.robot, m.incarnation(), g.frame());
+        pose.pose.time = Timestamp::FromNanoseconds(g.time_ns());
+        CAIRN_RETURN_IF_ERROR(GetPose(g.t_frame_body(), &pose.pose.T_frame_body, &pose.covariance, what));
+        in.graph_poses.push_back(pose);
+      }
+      return in;
+    }
+    case TeamItemKind::kSubmap: {
+      exchange::SubmapItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      auto submap = SubmapCodec::Decode(std::span<const uint8_t>(
+          reinterpret_cast<const uint8_t*>(m.encoded().data()), m.encoded().size()));
+      if (!submap.ok()) return DataLossError(what + ": " + submap.status().message());
+      if ((*submap)->metadata().robot != item.key.origin)
+        return DataLossError(what + ": the submap says it is of robot '" + (*submap)->metadata().robot + "'");
+      in.kind = TeamInput::Kind::kSubmap;
+      in.submap = *submap;
+      in.new_frame = index(in.robot, m.incarnation(), (*submap)->metadata().id);
+      return in;
+    }
+    case TeamItemKind::kMatch: {
+      exchange::SubmapMatchItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      if (m.covariance_size() != 16) return DataLossError(what + ": the covariance has " + std::to_string(m.covariance_size()) + " entries, not 16");
+      in.kind = TeamInput::Kind::kMatch;
+      TeamMatch& t = in.match;
+      t.robot_a = m.robot_a();
+      t.robot_b = m.robot_b();
+      t.letter_a = letter_of(t.robot_a);
+      t.letter_b = letter_of(t.robot_b);
+      t.frame_a = index(t.robot_a, m.incarnation_a(), m.frame_a());
+      t.frame_b = index(t.robot_b, m.incarnation_b(), m.frame_b());
+      const double v[5] = {m.x(), m.y(), m.z(), m.yaw(), m.tilt_sigma()};
+      for (double x : v) {
+        if (!std::isfinite(x)) return DataLossError(what + ": a value is not finite");
+      }
+      t.T_a_b = FourDofTransform(Eigen::Vector3d(m.x(), m.y(), m.z()), m.yaw());
+      for (int i = 0; i < 16; ++i) {
+        if (!std::isfinite(m.covariance(i))) return DataLossError(what + ": a covariance entry is not finite");
+        t.covariance(i / 4, i % 4) = m.covariance(i);
+      }
+      t.tilt_sigma = m.tilt_sigma();
+      return in;
+    }
+    case TeamItemKind::kAttempt: {
+      exchange::MatchAttemptItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      in.kind = TeamInput::Kind::kAttempt;
+      in.match.robot_a = m.robot_a();
+      in.match.robot_b = m.robot_b();
+      in.match.letter_a = letter_of(m.robot_a());
+      in.match.letter_b = letter_of(m.robot_b());
+      in.match.frame_a = index(m.robot_a(), m.incarnation_a(), m.frame_a());
+      in.match.frame_b = index(m.robot_b(), m.incarnation_b(), m.frame_b());
+      in.matched = m.matched();
+      in.outcome = m.outcome();
+      return in;
+    }
+  }
+  return DataLossError(what + ": unknown kind " + std::to_string(item.kind));
+}
+
+}  // namespace cairn

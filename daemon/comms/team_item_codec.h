@@ -1,0 +1,57 @@
+#pragma once
+// This robot's items into the exchange's payloads (io/proto/cairn/exchange.proto) and teammates'
+// payloads back into the pipeline's plain structs. Decoding checks everything a teammate could get
+// wrong (sizes, non-finite numbers, rotations that are not rotations) and names the item.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/status.h"
+#include "daemon/comms/item_store.h"
+#include "daemon/pipeline/estimation_stage.h"
+#include "daemon/pipeline/team_input.h"
+#include "mapping/submap.h"
+
+namespace cairn {
+
+enum class TeamItemKind : uint16_t {
+  kRunStart = 1,
+  kFrameSwitch = 2,
+  kPoseBatch = 3,
+  kSubmap = 4,
+  kMatch = 5,
+  kAttempt = 6,
+};
+
+// Which lane an item of `kind` travels in (submaps behind the constraints).
+uint8_t LaneOf(TeamItemKind kind);
+const char* TeamItemKindName(uint16_t kind);
+
+struct OwnEstimate {
+  FrameEstimate estimate;
+  bool graph_pose = false;
+  uint64_t pose_index = 0;
+};
+
+class TeamItemCodec {
+ public:
+  static std::string RunStart(uint32_t incarnation, const std::string& robot_kind, Timestamp start);
+  static std::string FrameSwitch(uint32_t incarnation, const FrameSwitchEvent& event);
+  static std::string PoseBatch(uint32_t incarnation, const std::vector<OwnEstimate>& estimates);
+  static Expected<std::string> Submap(uint32_t incarnation, const cairn::Submap& submap);
+  static std::string Match(const TeamMatch& match);
+  static std::string Attempt(const TeamMatch& pair, bool matched, const std::string& outcome);
+
+  // How a decoded item names graph variables: a robot's letter (0 for a robot not in the team
+  // file) and the index of its frame `frame` of run `incarnation`.
+  struct Names {
+    std::function<char(const std::string& robot)> letter_of;
+    std::function<uint64_t(const std::string& robot, uint32_t incarnation, uint64_t frame)> frame_index;
+  };
+  static Expected<TeamInput> Decode(const StoreItem& item, const Names& names);
+  static uint32_t IncarnationOf(const StoreItem& run_start);  // 0 when it does not decode
+};
+
+}  // namespace cairn

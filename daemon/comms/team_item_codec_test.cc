@@ -1,0 +1,144 @@
+#include "daemon/comms/team_item_codec.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "cairn/exchange.pb.h"
+#include "mapping/testing/submap_test_util.h"
+
+namespace cairn {
+namespace {
+
+TeamItemCodec::Names TestNames() {
+  TeamItemCodec::Names n;
+  n.letter_of = [](const std::string& r) { return r == "rover1" ? 'a' : r == "hexa" ? 'b' : char{0}; };
+  n.frame_index = [](const std::string&, uint32_t incarnation, uint64_t frame) {
+    return (static_cast<uint64_t>(incarnation) << 40) | frame;
+  };
+  return n;
+}
+
+StoreItem Item(const std::string& origin, TeamItemKind kind, std::string payload) {
+  StoreItem item;
+  item.key = ItemKey{origin, LaneOf(kind), 1};
+  item.kind = static_cast<uint16_t>(kind);
+  item.payload = std::move(payload);
+  return item;
+}
+
+FrameSwitchEvent Switch() {
+  FrameSwitchEvent e;
+  e.time = Timestamp::FromSeconds(12.5);
+  e.old_frame_id = 3;
+  e.new_frame_id = 4;
+  e.transform.T_old_new.translation() = Eigen::Vector3d(6.5, -0.25, 0.1);
+  e.transform.T_old_new.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  e.transform.covariance = Matrix6d::Identity() * 0.01;
+  e.transform.covariance(0, 1) = e.transform.covariance(1, 0) = 0.002;
+  return e;
+}
+
+TEST(TeamItemCodecTest, FrameSwitchRoundTripsWithItsRun) {
+  const FrameSwitchEvent e = Switch();
+  auto in = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, TeamItemCodec::FrameSwitch(2, e)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->kind, TeamInput::Kind::kFrameSwitch);
+  EXPECT_EQ(in->letter, 'b');
+  EXPECT_EQ(in->old_frame, (uint64_t{2} << 40) | 3);
+  EXPECT_EQ(in->new_frame, (uint64_t{2} << 40) | 4);
+  EXPECT_TRUE(in->T_old_new.isApprox(e.transform.T_old_new, 1e-12));
+  EXPECT_TRUE(in->switch_covariance.isApprox(e.transform.covariance, 1e-15));
+}
+
+TEST(TeamItemCodecTest, PoseBatchKeepsTrajectoryAndGraphPoses) {
+  std::vector<OwnEstimate> batch(3);
+  for (int i = 0; i < 3; ++i) {
+    batch[i].estimate.time = Timestamp::FromSeconds(1.0 + i);
+    batch[i].estimate.frame_id = 7;
+    batch[i].estimate.T_frame_body.translation() = Eigen::Vector3d(i, 2 * i, 0.5);
+    batch[i].estimate.pose_covariance = Matrix6d::Identity() * (i + 1) * 1e-4;
+  }
+  batch[1].graph_pose = true;
+  batch[1].pose_index = 42;
+  auto in = TeamItemCodec::Decode(Item("rover1", TeamItemKind::kPoseBatch, TeamItemCodec::PoseBatch(0, batch)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  ASSERT_EQ(in->poses.size(), 3u);
+  ASSERT_EQ(in->graph_poses.size(), 1u);
+  EXPECT_EQ(in->graph_poses[0].pose_index, 42u);
+  EXPECT_NEAR(in->poses[2].T_frame_body.translation().y(), 4.0, 1e-6);
+  EXPECT_EQ(in->poses[2].frame, 7u);
+  EXPECT_NEAR(in->graph_poses[0].covariance(3, 3), 2e-4, 1e-12);
+}
+
+TEST(TeamItemCodecTest, SubmapTravelsInItsWireFormat) {
+  const auto submap = testing::SyntheticSubmap(5);
+  auto payload = TeamItemCodec::Submap(0, *submap);
+  ASSERT_TRUE(payload.ok());
+  auto in = TeamItemCodec::Decode(Item("rover1", TeamItemKind::kSubmap, *payload), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->new_frame, 5u);
+  EXPECT_EQ(in->submap->points().size(), submap->points().size());
+  // A submap under another robot's name is refused.
+  auto lie = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kSubmap, *payload), TestNames());
+  ASSERT_FALSE(lie.ok());
+  EXPECT_NE(lie.status().ToString().find("hexa"), std::string::npos);
+  // So is a corrupt one, naming the item.
+  std::string bad = *payload;
+  bad[bad.size() / 2] ^= 0x5a;
+  auto corrupt = TeamItemCodec::Decode(Item("rover1", TeamItemKind::kSubmap, bad), TestNames());
+  ASSERT_FALSE(corrupt.ok());
+  EXPECT_NE(corrupt.status().ToString().find("rover1/1/1"), std::string::npos) << corrupt.status().ToString();
+}
+
+TEST(TeamItemCodecTest, MatchNamesBothRobotsAndTheirRuns) {
+  TeamMatch m;
+  m.robot_a = "rover1";
+  m.frame_a = 2;
+  m.robot_b = "hexa";
+  m.incarnation_b = 1;
+  m.frame_b = 9;
+  m.T_a_b = FourDofTransform(1.0, 2.0, 0.1, 0.5);
+  m.covariance = Eigen::Matrix4d::Identity() * 1e-4;
+  m.tilt_sigma = 0.01;
+  auto in = TeamItemCodec::Decode(Item("rover1", TeamItemKind::kMatch, TeamItemCodec::Match(m)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->match.letter_a, 'a');
+  EXPECT_EQ(in->match.letter_b, 'b');
+  EXPECT_EQ(in->match.frame_b, (uint64_t{1} << 40) | 9);
+  EXPECT_NEAR(in->match.T_a_b.yaw(), 0.5, 1e-12);
+  auto attempt = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kAttempt, TeamItemCodec::Attempt(m, false, "no match")), TestNames());
+  ASSERT_TRUE(attempt.ok());
+  EXPECT_FALSE(attempt->matched);
+  EXPECT_EQ(attempt->outcome, "no match");
+}
+
+TEST(TeamItemCodecTest, RefusesWhatATeammateCouldGetWrong) {
+  const auto names = TestNames();
+  // Not a protobuf, unknown kind.
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, "\xff\xff\xff"), names).ok());
+  StoreItem unknown = Item("hexa", TeamItemKind::kFrameSwitch, "");
+  unknown.kind = 99;
+  EXPECT_FALSE(TeamItemCodec::Decode(unknown, names).ok());
+  // NaN in a pose, a rotation that is not one, a covariance of the wrong size.
+  exchange::FrameSwitchItem m;
+  m.ParseFromString(TeamItemCodec::FrameSwitch(0, Switch()));
+  exchange::FrameSwitchItem nan = m;
+  nan.mutable_t_old_new()->set_tx(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, nan.SerializeAsString()), names).ok());
+  exchange::FrameSwitchItem skew = m;
+  skew.mutable_t_old_new()->set_qw(3.0);
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, skew.SerializeAsString()), names).ok());
+  exchange::FrameSwitchItem short_cov = m;
+  short_cov.mutable_t_old_new()->mutable_covariance()->RemoveLast();
+  auto s = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, short_cov.SerializeAsString()), names);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.status().ToString().find("20 entries"), std::string::npos) << s.status().ToString();
+  exchange::FrameSwitchItem self = m;
+  self.set_new_frame(self.old_frame());
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, self.SerializeAsString()), names).ok());
+}
+
+}  // namespace
+}  // namespace cairn

@@ -1,0 +1,71 @@
+#pragma once
+// What the team exchange hands the graph thread: one item of a teammate's log, decoded into plain
+// structs (the pipeline never sees the wire). Frames are the teammate's local frames (its submap
+// origins); poses and covariances follow the conventions of the teammate's own filter.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/timestamp.h"
+#include "estimation/graph/pose_graph.h"
+#include "mapping/matching/four_dof_transform.h"
+#include "mapping/submap.h"
+
+namespace cairn {
+
+struct TeamPose {
+  Timestamp time;
+  uint64_t frame = 0;
+  Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
+};
+
+struct TeamGraphPose {
+  uint64_t pose_index = 0;
+  TeamPose pose;
+  Matrix6d covariance = Matrix6d::Zero();  // [position; rotation], the filter's
+};
+
+// A submap match c between two origins (of one robot or two): B in A, with the matcher's
+// (x, y, z, yaw) covariance in A's axes.
+struct TeamMatch {
+  std::string robot_a;
+  char letter_a = 0;  // graph letters (from the team file)
+  uint32_t incarnation_a = 0;  // the robots' runs (on the wire; decoded frames include them)
+  uint64_t frame_a = 0;
+  std::string robot_b;
+  char letter_b = 0;
+  uint32_t incarnation_b = 0;
+  uint64_t frame_b = 0;
+  FourDofTransform T_a_b;
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Identity();
+  double tilt_sigma = 0.0;
+};
+
+struct TeamInput {
+  enum class Kind : uint8_t { kRunStart, kFrameSwitch, kPoses, kSubmap, kMatch, kAttempt };
+  Kind kind = Kind::kRunStart;
+  std::string robot;   // the item's origin
+  char letter = 0;     // its graph letter (from the team file)
+  // kFrameSwitch: the new origin in the old one; covariance with its translation in the old
+  // frame's axes, as the filter states it.
+  uint64_t old_frame = 0;
+  uint64_t new_frame = 0;
+  Eigen::Isometry3d T_old_new = Eigen::Isometry3d::Identity();
+  Matrix6d switch_covariance = Matrix6d::Zero();
+  Timestamp time;
+  // kPoses
+  std::vector<TeamPose> poses;
+  std::vector<TeamGraphPose> graph_poses;
+  // kSubmap (its frame index in new_frame)
+  std::shared_ptr<const Submap> submap;
+  // kMatch and kAttempt (then only the pair and `matched`)
+  TeamMatch match;
+  bool matched = false;
+  std::string outcome;
+};
+
+}  // namespace cairn

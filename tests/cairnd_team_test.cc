@@ -1,0 +1,155 @@
+// cairnd as a team: two simulated robots, each its own process, exchanging over loopback through
+// ZeroMQ with CURVE keys made by `cairn keys generate`, as the demo runs them; and an intruder
+// whose key the team file does not list, which gets nothing and injects nothing.
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "tests/support/json_value.h"
+#include "tests/support/process_runner.h"
+#include "tests/support/test_data.h"
+
+namespace cairn {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::JsonValue;
+using testing::ProcessResult;
+using testing::RunProcess;
+
+std::string Cairnd() { return testing::BinaryDir() + "/daemon/cairnd"; }
+std::string Cairn() { return testing::BinaryDir() + "/tools/cairn"; }
+std::string Config(const std::string& profile) { return testing::SourceDir() + "/configs/" + profile + ".yaml"; }
+
+std::string PublicKey(const std::string& pub_file) {
+  std::ifstream in(pub_file);
+  std::string word, key;
+  while (in >> word) {
+    if (word == "public-key" && in >> key) return key;
+  }
+  return "";
+}
+
+struct Member {
+  std::string name;
+  std::string letter;
+  std::string profile;
+  int port = 0;
+};
+
+// Writes a team file of `members` with the keys found in `keys_dir`.
+void WriteTeam(const std::string& path, const std::vector<Member>& members, const std::string& keys_dir) {
+  std::ofstream out(path);
+  out << "members:\n";
+  for (const Member& m : members) {
+    out << "  - {name: " << m.name << ", letter: " << m.letter << ", address: \"tcp://127.0.0.1:" << m.port
+        << "\", public_key: \"" << PublicKey(keys_dir + "/" + m.name + ".pub") << "\"}\n";
+  }
+}
+
+std::vector<std::string> TeamArgs(const Member& m, const std::string& team_file, const std::string& key_file,
+                                  const std::string& out) {
+  return {Cairnd(), "--config", Config(m.profile), "--sim", "--out", out,
+          "--set", "sim.duration=6", "--set", "sim.image_scale=0.25", "--set", "sim.robots=rover,hexacopter",
+          "--set", "replay.pacing=fast", "--set", "replay.deterministic=true",
+          "--set", "live.enabled=false", "--set", "recording.enabled=false",
+          "--set", "robot.name=" + m.name, "--set", "graph.optimizer.own_robot=" + m.letter,
+          "--set", "team.enabled=true", "--set", "team.members_file=" + team_file,
+          "--set", "team.secret_key_file=" + key_file, "--set", "team.linger=60",
+          "--log-level", "warn"};
+}
+
+const JsonValue* RobotEntry(const JsonValue& team, const std::string& name) {
+  for (const JsonValue& r : team["robots"].array()) {
+    if (r["name"].string() == name) return &r;
+  }
+  return nullptr;
+}
+
+TEST(CairndTeamTest, TwoRobotsHoldEachOthersItemsOnceAndAnIntruderGetsNothing) {
+  const std::string dir = testing::FreshTempDir("cairnd_team");
+  const std::string keys = dir + "/keys";
+  const std::string intruder_keys = dir + "/intruder_keys";
+  fs::create_directories(keys);
+  fs::create_directories(intruder_keys);
+  for (const std::string name : {"rover", "hexacopter"}) {
+    const ProcessResult r = RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys});
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  // The intruder knows the team's addresses and public keys, but its own key is not listed.
+  ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", "rover2", "--dir", intruder_keys}).exit_code, 0);
+  for (const std::string name : {"rover", "hexacopter"}) {
+    fs::copy_file(keys + "/" + name + ".pub", intruder_keys + "/" + name + ".pub");
+  }
+  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8;
+  const Member rover{"rover", "a", "rover", base};
+  const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
+  const Member intruder{"rover2", "c", "rover", base + 2};
+  WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
+  WriteTeam(dir + "/intruder.yaml", {rover, hexacopter, intruder}, intruder_keys);
+
+  testing::ProcessOptions options;
+  options.timeout = std::chrono::minutes(8);
+  ProcessResult results[3];
+  std::vector<std::thread> runs;
+  runs.emplace_back([&] {
+    results[0] = RunProcess(TeamArgs(rover, dir + "/team.yaml", keys + "/rover.key", dir + "/rover"), options);
+  });
+  runs.emplace_back([&] {
+    results[1] = RunProcess(TeamArgs(hexacopter, dir + "/team.yaml", keys + "/hexacopter.key", dir + "/hexacopter"),
+                            options);
+  });
+  runs.emplace_back([&] {
+    // It never settles (nobody answers): a short linger.
+    auto args = TeamArgs(intruder, dir + "/intruder.yaml", intruder_keys + "/rover2.key", dir + "/rover2");
+    args.push_back("--set");
+    args.push_back("team.linger=3");
+    args.push_back("--set");
+    args.push_back("sim.robots=rover,hexacopter,rover2");
+    results[2] = RunProcess(args, options);
+  });
+  for (std::thread& t : runs) t.join();
+  for (const ProcessResult& r : results) ASSERT_EQ(r.exit_code, 0) << r.output;
+
+  const JsonValue a = JsonValue::ParseFile(dir + "/rover/team.json");
+  const JsonValue b = JsonValue::ParseFile(dir + "/hexacopter/team.json");
+  const JsonValue c = JsonValue::ParseFile(dir + "/rover2/team.json");
+  EXPECT_TRUE(a["settled"].boolean());
+  EXPECT_TRUE(b["settled"].boolean());
+  // Every item a robot published is held by the other, once: counted by kind on both sides.
+  for (const auto& [self, other, other_name] :
+       {std::tuple(&a, &b, std::string("hexacopter")), std::tuple(&b, &a, std::string("rover"))}) {
+    const JsonValue* entry = RobotEntry(*self, other_name);
+    ASSERT_NE(entry, nullptr);
+    EXPECT_TRUE((*entry)["heard"].boolean());
+    const JsonValue& sent = (*other)["exchange"]["sent_items"];
+    ASSERT_GT(sent.object().size(), 0u);
+    for (const std::string kind : {"run_start", "frame_switch", "poses", "submap"}) {
+      if (!sent.has(kind)) continue;
+      EXPECT_EQ((*entry)["items"][kind].number(), sent[kind].number()) << other_name << " " << kind;
+    }
+    EXPECT_EQ((*self)["peers"][0]["refused_messages"].number(), 0);
+    EXPECT_EQ((*self)["peers"][0]["queued_items"].number(), 0);
+    EXPECT_GT((*self)["peers"][0]["sent_bytes_per_s"].number(), 0.0);
+    EXPECT_EQ((*self)["exchange"]["decode_errors"].number(), 0);
+  }
+  // The intruder was refused by both, heard from nobody, and nothing of it is in their logs.
+  EXPECT_GT(a["transport"]["refused_unknown_key"].number() + b["transport"]["refused_unknown_key"].number(), 0);
+  EXPECT_EQ(c["transport"]["received_messages"].number(), 0);
+  for (const JsonValue& p : c["peers"].array()) EXPECT_FALSE(p["heard"].boolean());
+  for (const JsonValue* self : {&a, &b}) EXPECT_EQ(RobotEntry(*self, "rover2"), nullptr);
+  for (const std::string store : {"/rover/exchange", "/hexacopter/exchange"}) {
+    for (const auto& f : fs::directory_iterator(dir + store)) {
+      EXPECT_EQ(f.path().filename().string().find("rover2"), std::string::npos) << f.path();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace cairn
