@@ -2,6 +2,7 @@
 // ZeroMQ with CURVE keys made by `cairn keys generate`, as the demo runs them; and an intruder
 // whose key the team file does not list, which gets nothing and injects nothing.
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -54,9 +55,9 @@ void WriteTeam(const std::string& path, const std::vector<Member>& members, cons
 }
 
 std::vector<std::string> TeamArgs(const Member& m, const std::string& team_file, const std::string& key_file,
-                                  const std::string& out) {
+                                  const std::string& out, double duration = 6.0) {
   return {Cairnd(), "--config", Config(m.profile), "--sim", "--out", out,
-          "--set", "sim.duration=6", "--set", "sim.image_scale=0.25", "--set", "sim.robots=rover,hexacopter",
+          "--set", "sim.duration=" + std::to_string(duration), "--set", "sim.image_scale=0.25", "--set", "sim.robots=rover,hexacopter",
           "--set", "replay.pacing=fast", "--set", "replay.deterministic=true",
           "--set", "live.enabled=false", "--set", "recording.enabled=false",
           "--set", "robot.name=" + m.name, "--set", "graph.optimizer.own_robot=" + m.letter,
@@ -149,6 +150,65 @@ TEST(CairndTeamTest, TwoRobotsHoldEachOthersItemsOnceAndAnIntruderGetsNothing) {
       EXPECT_EQ(f.path().filename().string().find("rover2"), std::string::npos) << f.path();
     }
   }
+}
+
+double ItemCount(const JsonValue& robot) {
+  double n = 0;
+  for (const auto& [kind, count] : robot["items"].object()) n += count.number();
+  return n;
+}
+
+// SIGKILL mid-run, then the same cairnd again on the same disk: the teammate ends up with every
+// item of both runs once, and the second run knows it is the robot's second incarnation.
+TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
+  const std::string dir = testing::FreshTempDir("cairnd_team_kill");
+  const std::string keys = dir + "/keys";
+  fs::create_directories(keys);
+  for (const std::string name : {"rover", "hexacopter"}) {
+    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys}).exit_code, 0);
+  }
+  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8 + 4;
+  const Member rover{"rover", "a", "rover", base};
+  const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
+  WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
+  testing::ProcessOptions options;
+  options.timeout = std::chrono::minutes(8);
+  ProcessResult killed, restarted, teammate;
+  std::thread team_thread([&] {
+    teammate = RunProcess(TeamArgs(hexacopter, dir + "/team.yaml", keys + "/hexacopter.key", dir + "/hexacopter"),
+                          options);
+  });
+  testing::ProcessOptions kill = options;
+  kill.signal = SIGKILL;
+  // Once the status line shows the link carrying items both ways, and a little later.
+  kill.signal_when_output_contains = "kB, received";
+  kill.signal_after = std::chrono::milliseconds(1000);
+  auto rover_args = TeamArgs(rover, dir + "/team.yaml", keys + "/rover.key", dir + "/rover", 30.0);
+  auto status_args = rover_args;
+  status_args.insert(status_args.end(), {"--set", "daemon.status_interval=0.2", "--log-level", "debug"});
+  killed = RunProcess(status_args, kill);
+  restarted = RunProcess(rover_args, options);
+  team_thread.join();
+  ASSERT_EQ(killed.term_signal, SIGKILL) << killed.output;
+  ASSERT_EQ(restarted.exit_code, 0) << restarted.output;
+  ASSERT_EQ(teammate.exit_code, 0) << teammate.output;
+
+  const JsonValue a = JsonValue::ParseFile(dir + "/rover/team.json");
+  const JsonValue b = JsonValue::ParseFile(dir + "/hexacopter/team.json");
+  EXPECT_TRUE(a["settled"].boolean());
+  EXPECT_TRUE(b["settled"].boolean());
+  EXPECT_EQ(a["incarnation"].number(), 1);
+  EXPECT_GT(a["exchange"]["earlier_run_items"].number(), 1);  // killed while exchanging
+  const JsonValue* rover_at_b = RobotEntry(b, "rover");
+  const JsonValue* rover_at_a = RobotEntry(a, "rover");
+  ASSERT_NE(rover_at_b, nullptr);
+  ASSERT_NE(rover_at_a, nullptr);
+  EXPECT_EQ((*rover_at_b)["items"]["run_start"].number(), 2);  // both runs
+  // The teammate holds exactly what the rover's store holds of the rover, over both runs.
+  EXPECT_EQ(ItemCount(*rover_at_b), ItemCount(*rover_at_a));
+  EXPECT_EQ(ItemCount(*RobotEntry(a, "hexacopter")), ItemCount(*RobotEntry(b, "hexacopter")));
+  EXPECT_EQ(b["exchange"]["decode_errors"].number(), 0);
+  EXPECT_EQ(a["exchange"]["store_errors"].number(), 0);
 }
 
 }  // namespace

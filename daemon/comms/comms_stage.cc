@@ -262,7 +262,6 @@ void CommsStage::PublishOwn(Timestamp now, bool flush) {
       case Outgoing::Kind::kFinish:
         FlushPoses();
         own_finished_ = true;
-        exchange_->SetFinished();
         break;
     }
   }
@@ -279,6 +278,7 @@ void CommsStage::Loop(std::stop_token stop) {
   while (!stop.stop_requested()) {
     Timestamp now = clock.Now();
     PublishOwn(now, false);
+    exchange_->SetFinished(own_finished_ && idle_.load(std::memory_order_acquire));
     exchange_->Pump(now, send);
     // Wait for a message at most until the exchange has something to do (and 50 ms, so that the
     // graph thread's items go out promptly).

@@ -85,6 +85,7 @@ class CommsStage final : public TeamLink {
   bool NextInput(TeamInput* input) override;
   void SetNotify(std::function<void()> notify) override;
   void FinishOwnLog() override;
+  void SetIdle(bool idle) override { idle_.store(idle, std::memory_order_release); }
   bool Settled() override { return settled_.load(std::memory_order_acquire); }
   double linger_seconds() const override { return setup_.team.linger; }
 
@@ -126,6 +127,7 @@ class CommsStage final : public TeamLink {
   std::deque<TeamInput> inbox_;
   std::function<void()> notify_;
   std::atomic<bool> settled_{false};
+  std::atomic<bool> idle_{false};
   mutable std::mutex links_mutex_;  // guards links_
   std::vector<TeamLinkStatus> links_;
   Timestamp next_links_refresh_;

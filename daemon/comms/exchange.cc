@@ -19,6 +19,8 @@ bool ValidOrigin(const std::string& name) {
 constexpr int64_t kRetryMilliseconds = 50;
 // A finished peer unheard for this many summary intervals has stopped.
 constexpr double kGoneSummaries = 5.0;
+// Settled must hold this many summary intervals: a teammate's change of mind arrives within one.
+constexpr double kStableSummaries = 3.0;
 
 uint32_t CrcOf(const std::string& bytes) {
   return Crc32::Of(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
@@ -479,12 +481,22 @@ Timestamp Exchange::NextWake(Timestamp now) {
   return wake;
 }
 
-void Exchange::SetFinished() {
-  finished_ = true;
+void Exchange::SetFinished(bool finished) {
+  if (finished == finished_) return;
+  finished_ = finished;
   AnnounceSoon();
 }
 
-bool Exchange::Settled(Timestamp now) const {
+bool Exchange::Settled(Timestamp now) {
+  if (!SettledNow(now)) {
+    settled_since_.reset();
+    return false;
+  }
+  if (!settled_since_) settled_since_ = now;
+  return now - *settled_since_ >= Duration::Seconds(kStableSummaries * options_.summary_interval);
+}
+
+bool Exchange::SettledNow(Timestamp now) const {
   if (!finished_) return false;
   const auto mine = store_.HighWaterMarks();
   const Duration quiet = Duration::Seconds(kGoneSummaries * options_.summary_interval);

@@ -13,6 +13,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -79,11 +80,13 @@ class Exchange {
   void Pump(Timestamp now, const Sender& send);
   // When Pump() has something to do next (for the caller's poll timeout).
   Timestamp NextWake(Timestamp now);
-  // This robot's own logs are complete; announced to the peers from now on.
-  void SetFinished();
+  // Whether this robot's own logs are complete (for now); announced to the peers.
+  void SetFinished(bool finished = true);
   // This robot finished, and every peer has finished and holds exactly what this robot holds (or
   // finished, went silent and left nothing here unheld).
-  bool Settled(Timestamp now) const;
+  // Holds once the condition has lasted a few summary intervals, so that a teammate that takes
+  // its finish back (new work) is heard first.
+  bool Settled(Timestamp now);
 
   const std::string& self() const { return self_; }
   std::vector<ExchangePeerStats> PeerStats() const;
@@ -118,6 +121,7 @@ class Exchange {
     uint64_t bytes = 0;
   };
 
+  bool SettledNow(Timestamp now) const;
   void OnSummary(Peer& peer, const std::string& name, const void* summary, Timestamp now);
   void OnFragment(Peer& peer, const void* fragment, Timestamp now);
   void Accept(Peer& from, StoreItem item);
@@ -144,6 +148,7 @@ class Exchange {
   uint64_t reorder_bytes_ = 0;
   uint64_t partial_bytes_ = 0;
   bool finished_ = false;
+  std::optional<Timestamp> settled_since_;
   uint64_t store_version_ = 1;  // counts the store's appends, so summaries know if they are current
   ExchangeStats stats_;
   // Payload of the item being fragmented, read once.

@@ -179,8 +179,10 @@ void Pipeline::StopAndDrain() {
       team_->FinishOwnLog();
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(team_->linger_seconds());
       while (!team_->Settled() && std::chrono::steady_clock::now() < deadline) {
-        if (!TakeTeamInputs()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        const bool took = TakeTeamInputs();
         if (matching_) matching_->Step(*graph_);
+        team_->SetIdle(!took && (matching_ == nullptr || matching_->Idle()));
+        if (!took) std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
       TakeTeamInputs();
     }

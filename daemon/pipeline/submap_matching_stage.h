@@ -82,6 +82,8 @@ class SubmapMatchingStage {
   void Step(GraphStage& graph);
   // End of the run (graph thread stopped): every pair matched, the pool stopped.
   void Drain(GraphStage& graph);
+  // Nothing in flight after a Step(): no candidate pair is left either.
+  bool Idle() const { return in_flight_ == 0; }
 
   const std::vector<MatchAttempt>& attempts() const { return attempts_; }
   SubmapMatchingReport report() const;

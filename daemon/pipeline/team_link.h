@@ -27,6 +27,9 @@ class TeamLink {
   virtual void SetNotify(std::function<void()> notify) = 0;
   // End of the data: this robot's log is complete (what is batched goes out now).
   virtual void FinishOwnLog() = 0;
+  // After the end of the data: whether this robot has anything left that may add items (matching
+  // of teammates' late submaps). Teammates count it finished only while it is idle.
+  virtual void SetIdle(bool idle) = 0;
   // Whether every teammate holds all this robot holds and this robot all they hold, all having
   // finished their logs; the end of the run waits for it at most `linger_seconds()`.
   virtual bool Settled() = 0;
