@@ -10,6 +10,8 @@ cd "$(dirname "$0")/.."
 cmake --preset release >/dev/null
 cmake --build --preset release --target cairnd cairn
 duration="${CAIRN_DEMO_DURATION:-60}"
+world="${CAIRN_DEMO_WORLD:-}"  # a world file; "" = the profiles' default world
+seed="${CAIRN_DEMO_SEED:-1}"
 port="${CAIRN_DEMO_PORT:-47701}"
 cairnd=./build/release/daemon/cairnd
 cairn=./build/release/tools/cairn
@@ -27,11 +29,11 @@ for i in "${!robots[@]}"; do
   echo "  - {name: $r, letter: ${letters[$i]}, address: \"tcp://127.0.0.1:$((port + i))\", public_key: \"$key\"}" \
     >>"$team/team.yaml"
 done
-common=(--sim --set "sim.duration=$duration" --set "sim.robots=$(IFS=,; echo "${robots[*]}")"
+common=(--sim --set "sim.duration=$duration" --set "sim.seed=$seed" ${world:+--set "sim.world=$world"} --set "sim.robots=$(IFS=,; echo "${robots[*]}")"
         --set replay.pacing=fast --set replay.deterministic=true --set live.enabled=false
         --set recording.enabled=false --set team.enabled=true --set "team.members_file=$team/team.yaml"
         --set team.linger=600 --log-level warn)
-echo "demo: simulating a ${duration} s mission of ${robots[*]} on the default world, exchanging over loopback"
+echo "demo: simulating a ${duration} s mission of ${robots[*]} on ${world:-the default world} (seed $seed), exchanging over loopback"
 pids=()
 for i in "${!robots[@]}"; do
   r=${robots[$i]}
