@@ -211,5 +211,48 @@ TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
   EXPECT_EQ(a["exchange"]["store_errors"].number(), 0);
 }
 
+// The item store on a full disk: the errors are counted and named, the items stored before stay,
+// and the robot goes on estimating to the end of its data.
+TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
+  if (geteuid() != 0) GTEST_SKIP() << "needs root to mount a small tmpfs";
+  const std::string dir = testing::FreshTempDir("cairnd_team_full");
+  const std::string store = dir + "/store";
+  fs::create_directories(store);
+  if (RunProcess({"/usr/bin/mount", "-t", "tmpfs", "-o", "size=8k", "tmpfs", store}).exit_code != 0) {
+    GTEST_SKIP() << "cannot mount a tmpfs here";
+  }
+  struct Unmount {
+    std::string path;
+    ~Unmount() { RunProcess({"/usr/bin/umount", path}); }
+  } unmount{store};
+  const std::string keys = dir + "/keys";
+  fs::create_directories(keys);
+  for (const std::string name : {"rover", "hexacopter"}) {
+    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys}).exit_code, 0);
+  }
+  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8 + 6;
+  const Member rover{"rover", "a", "rover", base};
+  const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
+  WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
+  auto args = TeamArgs(rover, dir + "/team.yaml", keys + "/rover.key", dir + "/rover", 20.0);
+  // Alone (the teammate never comes): only its own items, which fill its 8 KB soon.
+  args.insert(args.end(), {"--set", "team.store_dir=" + store, "--set", "team.linger=1"});
+  testing::ProcessOptions options;
+  options.timeout = std::chrono::minutes(8);
+  const ProcessResult r = RunProcess(args, options);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue s = JsonValue::ParseFile(dir + "/rover/summary.json");
+  EXPECT_EQ(s["stop_reason"].string(), "end_of_data");
+  EXPECT_TRUE(fs::exists(dir + "/rover/global_trajectory.tum"));
+  const JsonValue t = JsonValue::ParseFile(dir + "/rover/team.json");
+  EXPECT_GT(t["exchange"]["store_errors"].number(), 0);
+  ASSERT_GT(t["errors"].array().size(), 0u);
+  EXPECT_NE(t["errors"][0].string().find(store), std::string::npos) << t["errors"][0].string();
+  // What was stored before the disk filled is still there, whole: a new process reads it back.
+  const JsonValue* self = RobotEntry(t, "rover");
+  ASSERT_NE(self, nullptr);
+  EXPECT_GT(ItemCount(*self), 0);
+}
+
 }  // namespace
 }  // namespace cairn
