@@ -256,4 +256,34 @@ Expected<YamlDocument> LoadYamlWithOverrides(const std::string& path,
   return doc;
 }
 
+Expected<std::string> ReadListFile(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) return NotFoundError(path + ": cannot read the " + what);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+Expected<YAML::Node> ParseListDocument(const std::string& text, const std::string& source, const std::string& key) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    return InvalidArgumentError(source + ":" + std::to_string(e.mark.line + 1) + ": not YAML: " + e.msg);
+  }
+  if (!root.IsMap()) return InvalidArgumentError(source + ": expected a mapping with the key '" + key + "'");
+  for (const auto& entry : root) {
+    const std::string name = entry.first.as<std::string>();
+    if (name != key) {
+      const YAML::Mark mark = entry.first.Mark();
+      return InvalidArgumentError(source + (mark.line < 0 ? "" : ":" + std::to_string(mark.line + 1)) +
+                                  ": unknown key '" + name + "'");
+    }
+  }
+  const YAML::Node list = root[key];
+  if (!list || !list.IsSequence() || list.size() == 0)
+    return InvalidArgumentError(source + ": '" + key + "' must list at least one entry");
+  return list;
+}
+
 }  // namespace cairn

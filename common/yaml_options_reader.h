@@ -79,4 +79,10 @@ struct YamlDocument {
 Expected<YamlDocument> LoadYamlWithOverrides(const std::string& path,
                                              const std::vector<std::string>& overrides);
 
+// A file of one list (`key:` followed by entries, e.g. a team file): the whole text of `path`
+// (`what` names the file's kind in the error), and the list's non-empty sequence from `text`
+// (named `source` in errors, with the line of an unknown key).
+Expected<std::string> ReadListFile(const std::string& path, const std::string& what);
+Expected<YAML::Node> ParseListDocument(const std::string& text, const std::string& source, const std::string& key);
+
 }  // namespace cairn

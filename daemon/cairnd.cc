@@ -13,6 +13,7 @@
 #include "daemon/pipeline/pipeline.h"
 #include "daemon/run_summary.h"
 #include "daemon/submap_index.h"
+#include "daemon/detections_csv.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/team_summary.h"
@@ -183,6 +184,25 @@ int Cairnd::Run() {
           spdlog::error("{}: {}", config_path_, s.ToString());
           return 1;
         }
+      }
+    }
+    const bool no_carriers = options_.detection.carriers_file.empty() && options_.source != SourceKind::kSim;
+    if (options_.detection.enabled && no_carriers && options_.source == SourceKind::kReplay) {
+      // A recording says nothing about the team's tags: replays run without detection unless told.
+      spdlog::warn("{}: detection.carriers_file is empty: robot detection is off for this replay", config_path_);
+    } else if (options_.detection.enabled) {
+      Expected<TagCarrierTable> table = InvalidArgumentError(
+          "detection.carriers_file: needed outside the simulator (which tag is on which robot)");
+      if (!options_.detection.carriers_file.empty()) {
+        table = TagCarrierTable::Load(options_.detection.carriers_file);
+      } else if (options_.source == SourceKind::kSim) {
+        table = SimulatedTagCarriers(options_, config_path_);
+      }
+      Status s = table.ok() ? pipeline.EnableDetection(options_.detection, std::move(*table), options_.robot.name)
+                            : table.status();
+      if (!s.ok()) {
+        spdlog::error("{}: detection: {}", config_path_, s.ToString());
+        return 1;
       }
     }
   }
@@ -395,6 +415,9 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const 
   }
   if (const SubmapMatchingStage* matching = pipeline.matching(); matching != nullptr && options_.matching.write_csv) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/matches.csv", matching->FormatCsv()));
+  }
+  if (pipeline.detection() != nullptr && pipeline.graph() != nullptr && options_.detection.write_csv) {
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/detections.csv", FormatDetectionsCsv(pipeline.graph()->detections())));
   }
   if (pipeline.mapping_enabled() && options_.mapping.write_submaps) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(

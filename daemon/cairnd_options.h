@@ -12,6 +12,7 @@
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/executor_options.h"
 #include "daemon/pipeline/graph_stage_options.h"
+#include "daemon/pipeline/robot_detection_options.h"
 #include "daemon/pipeline/submap_matching_options.h"
 #include "daemon/pipeline/mapping_stage_options.h"
 #include "daemon/telemetry/live_stream_options.h"
@@ -111,6 +112,7 @@ struct CairndOptions {
   MappingStageOptions mapping;
   GraphStageOptions graph;
   SubmapMatchingOptions matching;
+  RobotDetectionOptions detection;
   TeamOptions team;
 
   void Visit(OptionsVisitor& v) {
@@ -133,6 +135,7 @@ struct CairndOptions {
     v.Section("mapping", mapping);
     v.Section("graph", graph);
     v.Section("matching", matching);
+    v.Section("detection", detection);
     v.Section("team", team);
   }
 };

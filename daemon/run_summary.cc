@@ -180,6 +180,23 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.EndArray();
     j.EndObject();
   }
+  if (const RobotDetectionStage* detection = p.detection()) {
+    // Tag sightings (thesis 6.2): what the detector saw, and what the graph made of them.
+    const RobotDetectionReport& r = detection->report();
+    j.Key("detection").BeginObject();
+    j.Field("images", r.images).Field("bad_images", r.bad_images).Field("tags", r.tags);
+    j.Field("own_tags", r.own_tags).Field("unknown_ids", r.unknown_ids).Field("pose_failures", r.pose_failures);
+    j.Field("usable", r.usable).Field("refused", r.refused);
+    if (const GraphStage* graph = p.graph()) {
+      const GraphStageReport g = graph->report();
+      j.Field("graph_detections", g.detections).Field("graph_landmark_observations", g.landmark_observations);
+      j.Field("graph_pending", g.detections_pending).Field("graph_unplaced", g.detections_unplaced);
+    }
+    j.Key("first_errors").BeginArray();
+    for (const auto& e : r.errors) j.String(e);
+    j.EndArray();
+    j.EndObject();
+  }
   const FaultReport f = p.fault_report();
   j.Key("faults").BeginObject();
   j.Field("total", f.total);

@@ -39,6 +39,7 @@ Expected<std::shared_ptr<const sim::MissionSimulator>> OpenSimulatedMission(cons
   mission.image_scale = o.image_scale;
   mission.motion_blur_samples = static_cast<int>(o.motion_blur_samples);
   mission.render_threads = static_cast<int>(o.render_threads);
+  mission.deploy_from_lander = o.deploy_from_lander;
   // The simulated platform controller speaks the layout this robot's decoder expects.
   mission.can = options.can;
   auto simulator = sim::MissionSimulator::Create(world, mission);
@@ -46,6 +47,28 @@ Expected<std::shared_ptr<const sim::MissionSimulator>> OpenSimulatedMission(cons
     return Status(simulator.status().code(), config_path + ": sim: " + simulator.status().message());
   }
   return std::shared_ptr<const sim::MissionSimulator>(std::move(*simulator));
+}
+
+Expected<TagCarrierTable> SimulatedTagCarriers(const CairndOptions& options, const std::string& config_path) {
+  auto mission = OpenSimulatedMission(options, config_path);
+  if (!mission.ok()) return mission.status();
+  TagCarrierTable table;
+  for (const sim::SimRobot& r : (*mission)->robots()) {
+    for (const sim::SimMarker& m : r.markers) {
+      CAIRN_RETURN_IF_ERROR(table.Add(m.id, r.name, false, m.size, m.T_body_marker));
+    }
+  }
+  const auto& landmarks = (*mission)->landmarks();
+  if (!landmarks.empty()) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const sim::SimMarker& m : landmarks) centre += m.T_body_marker.translation();
+    centre /= static_cast<double>(landmarks.size());
+    const Eigen::Isometry3d T_lander_world(Eigen::Translation3d(-centre));
+    for (const sim::SimMarker& m : landmarks) {
+      CAIRN_RETURN_IF_ERROR(table.Add(m.id, "lander", true, m.size, T_lander_world * m.T_body_marker));
+    }
+  }
+  return table;
 }
 
 Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path) {

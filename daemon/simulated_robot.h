@@ -6,6 +6,7 @@
 #include <string>
 
 #include "daemon/cairnd_options.h"
+#include "detection/tag_carrier_table.h"
 #include "estimation/eval/trajectory.h"
 #include "hal/calibration.h"
 #include "hal/sensor_source_interface.h"
@@ -26,6 +27,10 @@ struct SimulatedRobot {
 // it; for scoring outputs against the world too. Errors name `config_path` and the key.
 Expected<std::shared_ptr<const sim::MissionSimulator>> OpenSimulatedMission(const CairndOptions& options,
                                                                             const std::string& config_path);
+
+// Every tag of the simulated mission: the robots' (by name) and the lander's (landmark "lander",
+// its frame at the centre of its tags, axes of the world).
+Expected<TagCarrierTable> SimulatedTagCarriers(const CairndOptions& options, const std::string& config_path);
 
 // Errors name `config_path` and the offending key (sim.world, sim.robots, robot.name).
 Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const std::string& config_path);

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The main job on the built-in default, no hardware needed: installs what is missing, builds the
 # release preset, and runs a simulated mission of a team on the default world: one cairnd per robot
-# (two rovers and a hexacopter, as on the robots), talking over loopback through the team exchange
-# with CURVE keys made for the demo, each writing ./out/<robot>. Then replays the bundled real EuRoC
+# (two rovers and a hexacopter, as on the robots), deployed from the lander (each starts in front
+# of one of its tags), talking over loopback through the team exchange with CURVE keys made for
+# the demo, each writing ./out/<robot>. Then replays the bundled real EuRoC
 # excerpt into ./out/euroc when the shared data sets are present.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,7 +31,7 @@ for i in "${!robots[@]}"; do
     >>"$team/team.yaml"
 done
 common=(--sim --set "sim.duration=$duration" --set "sim.seed=$seed" ${world:+--set "sim.world=$world"} --set "sim.robots=$(IFS=,; echo "${robots[*]}")"
-        --set replay.pacing=fast --set replay.deterministic=true --set live.enabled=false
+        --set sim.deploy_from_lander=true --set replay.pacing=fast --set replay.deterministic=true --set live.enabled=false
         --set recording.enabled=false --set team.enabled=true --set "team.members_file=$team/team.yaml"
         --set team.linger=600 --log-level warn)
 echo "demo: simulating a ${duration} s mission of ${robots[*]} on ${world:-the default world} (seed $seed), exchanging over loopback"

@@ -70,12 +70,23 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
   std::unique_ptr<MissionSimulator> sim(new MissionSimulator(world, mission));
   const uint64_t seed = static_cast<uint64_t>(world.seed);
   const double tag = world.tag_size;
+  Deployment deployment;
+  if (mission.deploy_from_lander) {
+    if (world.lander.size() != 2) return InvalidArgumentError("deploying from the lander needs a lander in the world");
+    if (mission.robots.size() > 4) return InvalidArgumentError("the lander has four tags: at most 4 robots deploy from it");
+    deployment.enabled = true;
+    deployment.lander = Eigen::Vector2d(world.lander[0], world.lander[1]);
+    deployment.lander_ground = sim->terrain_.Height(world.lander[0], world.lander[1]);
+    const Eigen::Vector3d sun = sim->sun_direction();
+    deployment.sun = sun.head<2>().norm() > 1e-9 ? Eigen::Vector2d(sun.head<2>().normalized()) : Eigen::Vector2d::UnitX();
+  }
   for (size_t i = 0; i < mission.robots.size(); ++i) {
     const std::string& n = mission.robots[i];
     const int index = static_cast<int>(i);
-    sim->robots_.push_back(n.rfind("rover", 0) == 0
-                               ? MakeRover(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag)
-                               : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag));
+    sim->robots_.push_back(
+        n.rfind("rover", 0) == 0
+            ? MakeRover(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment)
+            : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment));
   }
   if (world.lander.size() == 2) {
     // A lander: a 1.6 m box on the ground with a tag on each side.

@@ -35,6 +35,9 @@ struct MissionOptions {
   // 2: RenderStereo renders the right camera on a thread of its own. Each image is computed by one
   // thread either way, so the bytes do not depend on this.
   int render_threads = 1;
+  // Every robot starts in front of one of the lander's tags and sets out from there (see
+  // Deployment in sim_robot.h); needs a lander in the world.
+  bool deploy_from_lander = false;
   Timestamp start = Timestamp::FromNanoseconds(int64_t{1700000000} * 1000000000);
   RenderOptions render;
   CanWheelOptions can;            // frame layout of the rovers' platform controllers

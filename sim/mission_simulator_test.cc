@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include <gtest/gtest.h>
 
+#include "detection/tag_detector.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "sim/rover_can_layout.h"
 #include "sim/world_file.h"
@@ -125,6 +127,58 @@ TEST(MissionSimulatorTest, RobotsSeeEachOther) {
   const RenderScene scene = (*sim)->SceneAt(0.5);
   EXPECT_EQ(scene.markers.size(), 3u + 1u + 4u);  // rover tags, hexacopter tag, lander tags
   EXPECT_EQ(scene.boxes.size(), 2u + 1u + 1u);
+}
+
+// Deployed from the lander, every robot starts in front of a tag of its own, facing it, sees it in
+// its left image while it initializes, and is on its way a few seconds later.
+TEST(MissionSimulatorTest, DeployedRobotsStartInFrontOfALanderTagAndSeeIt) {
+  MissionOptions m = ShortMission();
+  m.robots = {"rover", "hexacopter", "rover2"};
+  m.duration = 40.0;
+  m.image_scale = 1.0;
+  m.deploy_from_lander = true;
+  WorldOptions world = SmallWorld(3);
+  world.lander = {4.0, -3.0};
+  auto sim = MissionSimulator::Create(world, m);
+  ASSERT_TRUE(sim.ok()) << sim.status().ToString();
+  const Eigen::Vector2d lander(4.0, -3.0);
+  std::vector<int> faces;
+  for (size_t r = 0; r < (*sim)->robots().size(); ++r) {
+    const SimRobot& robot = (*sim)->robots()[r];
+    const TrajectoryState s = robot.trajectory.Evaluate(1.0);
+    const Eigen::Vector2d to_lander = lander - s.T_world_body.translation().head<2>();
+    EXPECT_NEAR(to_lander.norm(), robot.kind == SimRobotKind::kRover ? 2.6 : 3.0, 0.2) << robot.name;
+    const Eigen::Vector2d forward = s.T_world_body.linear().col(0).head<2>().normalized();
+    EXPECT_GT(forward.dot(to_lander.normalized()), std::cos(0.1)) << robot.name;
+    EXPECT_LT(s.velocity.norm(), 0.05) << robot.name;
+    if (robot.kind == SimRobotKind::kRover) {  // the hexacopter hovers above a rover's face
+      faces.push_back(static_cast<int>(std::lround(std::atan2(-to_lander.y(), -to_lander.x()) / (std::numbers::pi / 2))) & 3);
+    }
+    std::vector<uint8_t> left, right;
+    (*sim)->RenderStereo(r, 1.0, 10, &left, &right);
+    const PinholeRadTan& k = robot.stereo.left.intrinsics;
+    Image image;
+    image.data = std::shared_ptr<const uint8_t[]>(left.data(), [](const uint8_t*) {});
+    image.width = k.width;
+    image.height = k.height;
+    image.stride = k.width;
+    TagDetectorOptions o;
+    o.decimate = 1.0;
+    TagDetector detector(o);
+    const auto found = detector.Detect(image);
+    ASSERT_TRUE(found.ok());
+    bool lander_tag = false;
+    for (const TagDetection& d : *found) lander_tag = lander_tag || (d.id >= 200 && d.id <= 203);
+    EXPECT_TRUE(lander_tag) << robot.name << " does not see a lander tag";
+    EXPECT_GT(robot.trajectory.Evaluate(35.0).velocity.norm(), 0.2) << robot.name << " never set out";
+  }
+  std::sort(faces.begin(), faces.end());
+  EXPECT_EQ(std::unique(faces.begin(), faces.end()), faces.end()) << "two rovers share a face";
+  m.robots = {"rover", "rover2", "rover3", "rover4", "hexacopter"};
+  EXPECT_FALSE(MissionSimulator::Create(world, m).ok());
+  world.lander.clear();
+  m.robots = {"rover"};
+  EXPECT_FALSE(MissionSimulator::Create(world, m).ok());
 }
 
 // Motion blur averages the exposure: the image changes and loses high-frequency energy.

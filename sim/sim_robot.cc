@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <optional>
+#include <utility>
 #include <numbers>
 
 #include "sim/sim_random.h"
@@ -60,10 +63,84 @@ std::vector<Eigen::Vector3d> UnwrapYaw(std::vector<Eigen::Vector3d> e) {
   return e;
 }
 
+// A robot's path in the plane, by time from the moment it sets out on it.
+using PlanarPath = std::function<Eigen::Vector2d(double t)>;
+
+// Deployment from the lander: still in front of a tag until `still`, turning on the spot until
+// `t_turn`, then a cubic Hermite curve from rest at p0 to the path's point p1 (velocity m1) at
+// `t_join`, then the path from its time `t_entry` on.
+struct DeployPlan {
+  Eigen::Vector2d p0 = Eigen::Vector2d::Zero(), p1 = Eigen::Vector2d::Zero(), m1 = Eigen::Vector2d::Zero();
+  double yaw0 = 0.0, yaw_go = 0.0;
+  double still = 0.0, t_turn = 0.0, t_join = 0.0, t_entry = 0.0;
+};
+
+// `airborne`: a multicopter hovers above the ground robots, so it may share their face.
+DeployPlan PlanDeployment(Deployment* d, const PlanarPath& path, double period, double standoff, double still,
+                          double speed, bool airborne) {
+  DeployPlan plan;
+  plan.still = still;
+  // Join the path where it passes at about the standoff distance from the lander: a short drive.
+  double best = 1e300;
+  for (int k = 0; k < 720; ++k) {
+    const double t = period * k / 720.0;
+    const double score = std::abs((path(t) - d->lander).norm() - standoff);
+    if (score < best) {
+      best = score;
+      plan.t_entry = t;
+    }
+  }
+  plan.p1 = path(plan.t_entry);
+  plan.m1 = (path(plan.t_entry + 0.05) - path(plan.t_entry - 0.05)) / 0.1;
+  // A sunlit face that no rover took, looking most nearly the way to the path.
+  const Eigen::Vector2d to_path = plan.p1 - d->lander;
+  const double towards = std::atan2(to_path.y(), to_path.x());
+  int face = 0;
+  double best_score = -1e9;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d normal(std::cos(kPi / 2 * k), std::sin(kPi / 2 * k));
+    const bool taken = !airborne && ((d->taken_faces >> k) & 1u) != 0;
+    const double score = std::cos(towards - kPi / 2 * k) + (normal.dot(d->sun) > 0.05 ? 4.0 : 0.0) - (taken ? 16.0 : 0.0);
+    if (score > best_score) {
+      best_score = score;
+      face = k;
+    }
+  }
+  if (!airborne) d->taken_faces |= 1u << face;
+  const Eigen::Vector2d normal(std::cos(kPi / 2 * face), std::sin(kPi / 2 * face));
+  plan.p0 = d->lander + standoff * normal;
+  plan.yaw0 = std::atan2(-normal.y(), -normal.x());
+  const double drive = std::max(4.0, 1.5 * (plan.p1 - plan.p0).norm() / speed);
+  Eigen::Vector2d go = 3.0 * (plan.p1 - plan.p0) - drive * plan.m1;
+  if (go.norm() < 1e-6) go = plan.p1 - plan.p0;
+  plan.yaw_go = std::atan2(go.y(), go.x());
+  plan.t_turn = still + 1.0 + std::abs(Wrap(plan.yaw_go - plan.yaw0)) / 0.4;  // turning at 0.4 rad/s
+  plan.t_join = plan.t_turn + drive;
+  return plan;
+}
+
+// Position and heading at time `t` from the robot's start.
+std::pair<Eigen::Vector2d, double> DeployedPose(const DeployPlan& plan, const PlanarPath& path, double t) {
+  const auto xy = [&](double u) -> Eigen::Vector2d {
+    if (u <= plan.t_turn) return plan.p0;
+    if (u >= plan.t_join) return path(plan.t_entry + (u - plan.t_join));
+    const double T = plan.t_join - plan.t_turn, x = (u - plan.t_turn) / T;
+    const double h00 = 2 * x * x * x - 3 * x * x + 1, h01 = -2 * x * x * x + 3 * x * x, h11 = x * x * x - x * x;
+    return h00 * plan.p0 + h01 * plan.p1 + h11 * T * plan.m1;
+  };
+  if (t < plan.still) return {plan.p0, plan.yaw0};
+  if (t < plan.t_turn) {
+    const double x = (t - plan.still) / (plan.t_turn - plan.still), smooth = x * x * (3 - 2 * x);
+    return {plan.p0, plan.yaw0 + Wrap(plan.yaw_go - plan.yaw0) * smooth};
+  }
+  const Eigen::Vector2d ahead = xy(t + 0.05) - xy(t - 0.05);
+  return {xy(t), ahead.norm() > 1e-9 ? std::atan2(ahead.y(), ahead.x()) : plan.yaw_go};
+}
+
 }  // namespace
 
 SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
-                   double duration, double image_scale, double tag_size) {
+                   double duration, double image_scale, double tag_size, Deployment* deployment) {
   SimRobot r;
   r.name = name;
   r.kind = SimRobotKind::kRover;
@@ -91,10 +168,23 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
   // It stands still before it drives off, as a rover does until its estimator has initialized
   // (wheels turning hold the filter's static initialization back).
   const double still = 2.0;  // s
+  const PlanarPath loop = [&](double t) { return xy_at(speed * t); };
+  std::optional<DeployPlan> plan;
+  // In front of a lander tag: the camera (1.3 m up, 25 deg down) sees the tag, 0.7 m up, from 1.6 m.
+  if (deployment != nullptr && deployment->enabled) {
+    plan = PlanDeployment(deployment, loop, 2 * kPi * R0 / speed, 2.6, still, speed, false);
+  }
   for (int i = 0; i < n; ++i) {
-    const double s = speed * std::max(0.0, kKnot * (i - 1) - still);
-    const Eigen::Vector2d p = xy_at(s), ahead = xy_at(s + 0.05) - xy_at(s - 0.05);
-    const double yaw = std::atan2(ahead.y(), ahead.x());
+    Eigen::Vector2d p;
+    double yaw = 0.0;
+    if (plan) {
+      std::tie(p, yaw) = DeployedPose(*plan, loop, kKnot * (i - 1));
+    } else {
+      const double s = speed * std::max(0.0, kKnot * (i - 1) - still);
+      const Eigen::Vector2d ahead = xy_at(s + 0.05) - xy_at(s - 0.05);
+      p = xy_at(s);
+      yaw = std::atan2(ahead.y(), ahead.x());
+    }
     const Eigen::Rotation2Dd R(yaw);
     double hw[4];
     for (size_t w = 0; w < 4; ++w) {
@@ -129,7 +219,7 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
 }
 
 SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
-                        double duration, double image_scale, double tag_size) {
+                        double duration, double image_scale, double tag_size, Deployment* deployment) {
   SimRobot r;
   r.name = name;
   r.kind = SimRobotKind::kHexacopter;
@@ -145,11 +235,39 @@ SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int ind
   // initialization needs: a multicopter in flight is never still).
   const double hover = 2.0;  // s
   const auto th_at = [&](int i) { return phase + speed * std::max(0.0, kKnot * (i - 1) - hover) / R0; };
+  const auto figure8 = [&](double th) {
+    return Eigen::Vector2d(R0 * Eigen::Vector2d(std::cos(th), 0.6 * std::sin(2 * th) + std::sin(th) * 0.4));
+  };
+  const auto height = [&](const Eigen::Vector2d& p, double th) {
+    return terrain.Height(p.x(), p.y()) + altitude + 0.5 * std::sin(3 * th);
+  };
+  std::optional<DeployPlan> plan;
+  std::vector<double> deployed_yaw;
+  const PlanarPath path = [&](double t) { return figure8(phase + speed * t / R0); };
+  // 2 m out from a lander tag and 2 m above it: the camera, 60 deg down, sees it 45 deg down.
+  if (deployment != nullptr && deployment->enabled) {
+    plan = PlanDeployment(deployment, path, 2 * kPi * R0 / speed, 3.0, hover, speed, true);
+  }
   for (int i = 0; i < n; ++i) {
-    const double th = th_at(i);
-    const Eigen::Vector2d p = R0 * Eigen::Vector2d(std::cos(th), 0.6 * std::sin(2 * th) + std::sin(th) * 0.4);
-    double ground = terrain.Height(p.x(), p.y());
-    pos.emplace_back(p.x(), p.y(), ground + altitude + 0.5 * std::sin(3 * th));
+    const double t = kKnot * (i - 1);
+    if (!plan) {
+      const double th = th_at(i);
+      const Eigen::Vector2d p = figure8(th);
+      pos.emplace_back(p.x(), p.y(), height(p, th));
+      continue;
+    }
+    const auto [p, yaw] = DeployedPose(*plan, path, t);
+    deployed_yaw.push_back(yaw);
+    const double z0 = deployment->lander_ground + 0.7 + 2.0;
+    const double th_entry = phase + speed * plan->t_entry / R0;
+    double z = z0;
+    if (t >= plan->t_join) {
+      z = height(p, phase + speed * (plan->t_entry + t - plan->t_join) / R0);
+    } else if (t > plan->t_turn) {
+      const double x = (t - plan->t_turn) / (plan->t_join - plan->t_turn);
+      z = z0 + (height(plan->p1, th_entry) - z0) * x * x * (3 - 2 * x);
+    }
+    pos.emplace_back(p.x(), p.y(), z);
   }
   // Heading along the path; roll and pitch lean into the horizontal acceleration as a multirotor.
   for (int i = 0; i < n; ++i) {
@@ -161,7 +279,9 @@ SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int ind
     // Hovering, it already faces along the path (its tangent at the start).
     const double th = th_at(i);
     const Eigen::Vector2d tangent(-std::sin(th), 1.2 * std::cos(2 * th) + 0.4 * std::cos(th));
-    const double yaw = vel.head<2>().norm() > 1e-6 ? std::atan2(vel.y(), vel.x()) : std::atan2(tangent.y(), tangent.x());
+    const double yaw = plan ? deployed_yaw[static_cast<size_t>(i)]
+                       : vel.head<2>().norm() > 1e-6 ? std::atan2(vel.y(), vel.x())
+                                                      : std::atan2(tangent.y(), tangent.x());
     const Eigen::Vector2d acc_body = Eigen::Rotation2Dd(-yaw) * acc.head<2>();
     euler.emplace_back(yaw, std::atan2(acc_body.x(), 9.81), -std::atan2(acc_body.y(), 9.81));
   }

@@ -44,12 +44,24 @@ struct SimRobot {
   std::vector<Eigen::Vector3d> wheels;
 };
 
+// Where robots start when the mission deploys them from the lander: each in front of one of the
+// lander's four tags (its own face, nearest the way to its path), seeing it while it initializes,
+// then it turns and goes onto its path where the path passes nearest the lander.
+struct Deployment {
+  bool enabled = false;
+  Eigen::Vector2d lander = Eigen::Vector2d::Zero();
+  double lander_ground = 0.0;  // terrain height at the lander
+  // Towards the sun, horizontal: robots prefer sunlit faces (a tag in the shadow has little contrast).
+  Eigen::Vector2d sun = Eigen::Vector2d::UnitX();
+  unsigned taken_faces = 0;    // bit k: face k (outward normal at k * 90 deg) is a rover's
+};
+
 // LRU-like rover (1024 x 508, f = 1080 px, b = 0.09 m; MTi-10 IMU) driving a seeded loop.
 // `image_scale` shrinks the cameras (tests); `index` separates robots of one mission.
 SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
-                   double duration, double image_scale, double tag_size);
+                   double duration, double image_scale, double tag_size, Deployment* deployment = nullptr);
 // Ardea-like hexacopter: stereo pair (666 x 506, b = 0.12 m) pitched 60 deg down, 400 Hz IMU.
 SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
-                        double duration, double image_scale, double tag_size);
+                        double duration, double image_scale, double tag_size, Deployment* deployment = nullptr);
 
 }  // namespace cairn::sim

@@ -17,6 +17,7 @@ struct SimSourceOptions {
   double image_scale = 1.0;              // < 1 shrinks every camera
   int64_t motion_blur_samples = 1;       // > 1 averages instants over the exposure
   int64_t render_threads = 2;            // 2: the right camera renders on a second thread
+  bool deploy_from_lander = false;       // every robot starts in front of a lander tag
 
   void Visit(OptionsVisitor& v) {
     v.Text("world", world);
@@ -26,6 +27,7 @@ struct SimSourceOptions {
     v.Number("image_scale", image_scale, 0.05, 1.0, "");
     v.Integer("motion_blur_samples", motion_blur_samples, 1, 64, "");
     v.Integer("render_threads", render_threads, 1, 2, "");
+    v.Flag("deploy_from_lander", deploy_from_lander);
   }
 };
 

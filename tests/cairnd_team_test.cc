@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -252,6 +253,58 @@ TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
   const JsonValue* self = RobotEntry(t, "rover");
   ASSERT_NE(self, nullptr);
   EXPECT_GT(ItemCount(*self), 0);
+}
+
+// Deployed from the lander, both robots see its tags while they initialize: their sightings (o
+// factors on the one lander variable) tie each robot's subgraph to the other's, on both robots.
+TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
+  const std::string dir = testing::FreshTempDir("cairnd_team_lander");
+  const std::string keys = dir + "/keys";
+  fs::create_directories(keys);
+  for (const std::string name : {"rover", "hexacopter"}) {
+    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys}).exit_code, 0);
+  }
+  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8 + 4;
+  const Member rover{"rover", "a", "rover", base};
+  const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
+  WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
+  testing::ProcessOptions options;
+  options.timeout = std::chrono::minutes(12);
+  ProcessResult results[2];
+  std::vector<std::thread> runs;
+  const Member* members[2] = {&rover, &hexacopter};
+  for (int i = 0; i < 2; ++i) {
+    runs.emplace_back([&, i] {
+      auto args = TeamArgs(*members[i], dir + "/team.yaml", keys + "/" + members[i]->name + ".key",
+                           dir + "/" + members[i]->name, 8.0);
+      // Full-size images: the hexacopter sees the 0.32 m tag from 2.8 m.
+      *std::find(args.begin(), args.end(), "sim.image_scale=0.25") = "sim.image_scale=1";
+      args.insert(args.end(), {"--set", "sim.deploy_from_lander=true"});
+      results[i] = RunProcess(args, options);
+    });
+  }
+  for (std::thread& t : runs) t.join();
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_EQ(results[i].exit_code, 0) << results[i].output;
+    const std::string out = dir + "/" + members[i]->name;
+    const JsonValue t = JsonValue::ParseFile(out + "/team.json");
+    EXPECT_EQ(t["connected"].array().size(), 2u) << members[i]->name;
+    EXPECT_EQ(t["not_connected"].array().size(), 0u) << members[i]->name;
+    const std::string teammate = members[1 - i]->name;
+    EXPECT_TRUE(fs::exists(out + "/global_trajectory_" + teammate + ".tum")) << members[i]->name;
+    // Each robot's sightings, and its teammate's, became factors here.
+    std::ifstream csv(out + "/detections.csv");
+    std::string line;
+    int factors[2] = {0, 0};
+    while (std::getline(csv, line)) {
+      if (!line.ends_with(",factor")) continue;
+      for (int k = 0; k < 2; ++k) factors[k] += line.find("," + members[k]->name + ",lander,1,") != std::string::npos;
+    }
+    EXPECT_GT(factors[0], 0) << members[i]->name << " has no factor from the rover's sightings";
+    EXPECT_GT(factors[1], 0) << members[i]->name << " has no factor from the hexacopter's sightings";
+    const JsonValue s = JsonValue::ParseFile(out + "/summary.json");
+    EXPECT_GT(s["detection"]["usable"].number(), 0) << members[i]->name;
+  }
 }
 
 }  // namespace

@@ -41,7 +41,7 @@ const std::vector<Part>& Parts() {
       {"detection/", {"hal/", "common/"}},
       {"fpga/", {"stereo/", "hal/", "common/"}},
       {"drivers/", {"hal/", "io/", "common/"}},
-      {"sim/", {"drivers/", "mapping/", "stereo/", "estimation/", "hal/", "io/", "common/"}},
+      {"sim/", {"drivers/", "detection/", "mapping/", "stereo/", "estimation/", "hal/", "io/", "common/"}},
       {"daemon/telemetry/", {"mapping/", "stereo/", "estimation/", "hal/", "io/", "common/"}},
       {"daemon/pipeline/",
        {"daemon/telemetry/", "detection/", "fpga/", "mapping/", "stereo/", "estimation/", "hal/", "io/", "common/"}},

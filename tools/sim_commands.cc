@@ -25,7 +25,8 @@ namespace {
 constexpr const char* kSimUsage =
     "usage: cairn sim [--world WORLD.yaml] [--robots rover,hexacopter] [--duration SECONDS]\n"
     "                 [--seed N] [--rover-config FILE] [--image-scale S] [--motion-blur N]\n"
-    "                 --out DIR\n"
+    "                 [--deploy-from-lander yes|no] --out DIR\n"
+    "  --deploy-from-lander: every robot starts in front of one of the lander's tags (default no)\n"
     "  --motion-blur:  average N instants over each exposure (default 1: off)\n"
     "  --rover-config: cairnd profile whose 'can:' section gives the wheel CAN layout\n"
     "                  (default: the simulated rover's built-in layout, as in configs/rover.yaml)\n";
@@ -113,6 +114,8 @@ int RunSim(const CommandArgs& args) {
       mission.robots = SplitComma(value);
     } else if (a == "--duration" && has_value && ParseDouble(value, &number)) {
       mission.duration = number;
+    } else if (a == "--deploy-from-lander" && has_value && (value == "yes" || value == "no")) {
+      mission.deploy_from_lander = value == "yes";
     } else if (a == "--motion-blur" && has_value && ParseDouble(value, &number) && number >= 1 && number <= 64) {
       mission.motion_blur_samples = static_cast<int>(number);
     } else if (a == "--image-scale" && has_value && ParseDouble(value, &number) && number > 0.01 && number <= 1.0) {

@@ -176,6 +176,13 @@ void CommsStage::PublishAttempt(const TeamMatch& pair, bool matched, const std::
   Push(std::move(o));
 }
 
+void CommsStage::PublishDetection(const TeamDetection& detection) {
+  Outgoing o;
+  o.kind = Outgoing::Kind::kDetection;
+  o.detection = detection;
+  Push(std::move(o));
+}
+
 void CommsStage::FinishOwnLog() {
   Outgoing o;
   o.kind = Outgoing::Kind::kFinish;
@@ -258,6 +265,10 @@ void CommsStage::PublishOwn(Timestamp now, bool flush) {
       case Outgoing::Kind::kAttempt:
         SplitFrames(&o.match);
         Publish(TeamItemKind::kAttempt, TeamItemCodec::Attempt(o.match, o.matched, o.outcome));
+        break;
+      case Outgoing::Kind::kDetection:
+        // Teammates hold it until the poses around its time arrive (batched as usual).
+        Publish(TeamItemKind::kDetection, TeamItemCodec::Detection(report_.incarnation, o.detection));
         break;
       case Outgoing::Kind::kFinish:
         FlushPoses();

@@ -82,6 +82,7 @@ class CommsStage final : public TeamLink {
   void PublishSubmap(std::shared_ptr<const Submap> submap) override;
   void PublishMatch(const TeamMatch& match) override;
   void PublishAttempt(const TeamMatch& pair, bool matched, const std::string& outcome) override;
+  void PublishDetection(const TeamDetection& detection) override;
   bool NextInput(TeamInput* input) override;
   void SetNotify(std::function<void()> notify) override;
   void FinishOwnLog() override;
@@ -91,7 +92,7 @@ class CommsStage final : public TeamLink {
 
  private:
   struct Outgoing {
-    enum class Kind : uint8_t { kSwitch, kEstimate, kSubmap, kMatch, kAttempt, kFinish };
+    enum class Kind : uint8_t { kSwitch, kEstimate, kSubmap, kMatch, kAttempt, kDetection, kFinish };
     Kind kind = Kind::kEstimate;
     FrameSwitchEvent frame_switch;
     OwnEstimate estimate;
@@ -99,6 +100,7 @@ class CommsStage final : public TeamLink {
     TeamMatch match;
     bool matched = false;
     std::string outcome;
+    TeamDetection detection;
   };
 
   explicit CommsStage(const CommsSetup& setup);

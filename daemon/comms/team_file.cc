@@ -1,9 +1,7 @@
 #include "daemon/comms/team_file.h"
 
 #include <cctype>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include <yaml-cpp/yaml.h>
 
@@ -37,28 +35,15 @@ Status TeamMember::Validate() const {
 }
 
 Expected<TeamFile> TeamFile::Load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return NotFoundError(path + ": cannot read the team file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return Parse(text.str(), path);
+  auto text = ReadListFile(path, "team file");
+  if (!text.ok()) return text.status();
+  return Parse(*text, path);
 }
 
 Expected<TeamFile> TeamFile::Parse(const std::string& text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    return InvalidArgumentError(source + ":" + std::to_string(e.mark.line + 1) + ": not YAML: " + e.msg);
-  }
-  if (!root.IsMap()) return InvalidArgumentError(source + ": expected a mapping with the key 'members'");
-  for (const auto& entry : root) {
-    const std::string key = entry.first.as<std::string>();
-    if (key != "members") return InvalidArgumentError(Where(source, entry.first) + ": unknown key '" + key + "'");
-  }
-  const YAML::Node members = root["members"];
-  if (!members || !members.IsSequence() || members.size() == 0)
-    return InvalidArgumentError(source + ": 'members' must list at least one robot");
+  auto list = ParseListDocument(text, source, "members");
+  if (!list.ok()) return list.status();
+  const YAML::Node members = *list;
   TeamFile file;
   file.path = source;
   std::set<std::string> names, letters, addresses;

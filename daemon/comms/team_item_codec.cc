@@ -1,5 +1,6 @@
 #include "daemon/comms/team_item_codec.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "cairn/exchange.pb.h"
@@ -72,6 +73,7 @@ const char* TeamItemKindName(uint16_t kind) {
     case TeamItemKind::kSubmap: return "submap";
     case TeamItemKind::kMatch: return "match";
     case TeamItemKind::kAttempt: return "attempt";
+    case TeamItemKind::kDetection: return "detection";
   }
   return "unknown";
 }
@@ -154,6 +156,19 @@ std::string TeamItemCodec::Attempt(const TeamMatch& pair, bool matched, const st
   SetPair(pair, &m);
   m.set_matched(matched);
   m.set_outcome(outcome.substr(0, 200));
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::Detection(uint32_t incarnation, const TeamDetection& d) {
+  exchange::DetectionItem m;
+  m.set_incarnation(incarnation);
+  m.set_time_ns(d.time.nanoseconds());
+  m.set_observed(d.observed);
+  m.set_landmark(d.landmark);
+  m.set_tag_id(static_cast<uint32_t>(std::max(d.tag_id, 0)));
+  SetPose(m.mutable_t_observer_observed(), d.T_observer_observed, &d.covariance);
+  m.set_distance(d.distance);
+  m.set_view_angle(d.view_angle);
   return m.SerializeAsString();
 }
 
@@ -270,6 +285,25 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       in.match.frame_b = index(m.robot_b(), m.incarnation_b(), m.frame_b());
       in.matched = m.matched();
       in.outcome = m.outcome();
+      return in;
+    }
+    case TeamItemKind::kDetection: {
+      exchange::DetectionItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      in.kind = TeamInput::Kind::kDetection;
+      TeamDetection& d = in.detection;
+      d.time = Timestamp::FromNanoseconds(m.time_ns());
+      d.observer = in.robot;
+      d.observer_letter = in.letter;
+      d.observed = m.observed();
+      d.landmark = m.landmark();
+      if (d.observed.empty() || d.observed.size() > 64) return DataLossError(what + ": names no observed robot or landmark");
+      d.observed_letter = d.landmark ? 0 : letter_of(d.observed);
+      d.tag_id = static_cast<int>(std::min<uint32_t>(m.tag_id(), 1u << 20));
+      CAIRN_RETURN_IF_ERROR(GetPose(m.t_observer_observed(), &d.T_observer_observed, &d.covariance, what));
+      if (d.covariance.llt().info() != Eigen::Success) return DataLossError(what + ": the covariance is not positive definite");
+      d.distance = std::isfinite(m.distance()) ? m.distance() : 0.0;
+      d.view_angle = std::isfinite(m.view_angle()) ? m.view_angle() : 0.0;
       return in;
     }
   }

@@ -23,6 +23,7 @@ enum class TeamItemKind : uint16_t {
   kSubmap = 4,
   kMatch = 5,
   kAttempt = 6,
+  kDetection = 7,
 };
 
 // Which lane an item of `kind` travels in (submaps behind the constraints).
@@ -43,6 +44,7 @@ class TeamItemCodec {
   static Expected<std::string> Submap(uint32_t incarnation, const cairn::Submap& submap);
   static std::string Match(const TeamMatch& match);
   static std::string Attempt(const TeamMatch& pair, bool matched, const std::string& outcome);
+  static std::string Detection(uint32_t incarnation, const TeamDetection& detection);
 
   // How a decoded item names graph variables: a robot's letter (0 for a robot not in the team
   // file) and the index of its frame `frame` of run `incarnation`.

@@ -114,6 +114,51 @@ TEST(TeamItemCodecTest, MatchNamesBothRobotsAndTheirRuns) {
   EXPECT_EQ(attempt->outcome, "no match");
 }
 
+TEST(TeamItemCodecTest, DetectionNamesTheObservedRobotOrLandmark) {
+  TeamDetection d;
+  d.time = Timestamp::FromSeconds(41.25);
+  d.observed = "rover1";
+  d.tag_id = 12;
+  d.T_observer_observed.translation() = Eigen::Vector3d(3.5, -0.4, -2.1);
+  d.T_observer_observed.linear() = Eigen::AngleAxisd(2.5, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  d.covariance = Matrix6d::Identity() * 0.003;
+  d.covariance(0, 5) = d.covariance(5, 0) = 0.0004;
+  d.distance = 4.2;
+  d.view_angle = 0.5;
+  auto in = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kDetection, TeamItemCodec::Detection(1, d)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->kind, TeamInput::Kind::kDetection);
+  const TeamDetection& got = in->detection;
+  EXPECT_EQ(got.observer, "hexa");
+  EXPECT_EQ(got.observer_letter, 'b');
+  EXPECT_EQ(got.observed, "rover1");
+  EXPECT_EQ(got.observed_letter, 'a');
+  EXPECT_FALSE(got.landmark);
+  EXPECT_EQ(got.tag_id, 12);
+  EXPECT_EQ(got.time, d.time);
+  EXPECT_TRUE(got.T_observer_observed.isApprox(d.T_observer_observed, 1e-12));
+  EXPECT_TRUE(got.covariance.isApprox(d.covariance, 1e-12));
+  EXPECT_DOUBLE_EQ(got.distance, 4.2);
+
+  d.observed = "lander";
+  d.landmark = true;
+  auto lander = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kDetection, TeamItemCodec::Detection(1, d)), TestNames());
+  ASSERT_TRUE(lander.ok());
+  EXPECT_TRUE(lander->detection.landmark);
+  EXPECT_EQ(lander->detection.observed_letter, 0);
+
+  // A covariance that is not one, and no name.
+  TeamDetection bad = d;
+  bad.covariance(2, 2) = -1.0;
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kDetection, TeamItemCodec::Detection(1, bad)), TestNames()).ok());
+  bad = d;
+  bad.covariance = Matrix6d::Zero();
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kDetection, TeamItemCodec::Detection(1, bad)), TestNames()).ok());
+  bad = d;
+  bad.observed.clear();
+  EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kDetection, TeamItemCodec::Detection(1, bad)), TestNames()).ok());
+}
+
 TEST(TeamItemCodecTest, RefusesWhatATeammateCouldGetWrong) {
   const auto names = TestNames();
   // Not a protobuf, unknown kind.

@@ -49,6 +49,8 @@ struct ExecutorsOptions {
   ExecutorOptions matcher;
   // The team exchange: the item store, ZeroMQ sockets and submap encoding (team.enabled).
   ExecutorOptions comms;
+  // AprilTag detection of teammates and landmarks on the left rectified image (detection.enabled).
+  ExecutorOptions detection;
 
   void Visit(OptionsVisitor& v) {
     v.Section("estimation", estimation);
@@ -60,6 +62,7 @@ struct ExecutorsOptions {
     v.Section("graph_full_solve", graph_full_solve);
     v.Section("matcher", matcher);
     v.Section("comms", comms);
+    v.Section("detection", detection);
   }
 };
 
@@ -78,6 +81,9 @@ struct QueueOptions {
   int64_t graph = 4096;
   // Finished submaps waiting for the matcher.
   int64_t submaps = 64;
+  // Rectified pairs waiting for tag detection, and its sightings waiting for the graph.
+  int64_t detection = 2;
+  int64_t sightings = 256;
 
   void Visit(OptionsVisitor& v) {
     v.Integer("imu", imu, 2, 1 << 20, "samples");
@@ -88,6 +94,8 @@ struct QueueOptions {
     v.Integer("telemetry", telemetry, 2, 1 << 20, "samples");
     v.Integer("graph", graph, 2, 1 << 20, "items");
     v.Integer("submaps", submaps, 2, 1 << 16, "submaps");
+    v.Integer("detection", detection, 2, 1024, "frames");
+    v.Integer("sightings", sightings, 2, 1 << 20, "sightings");
   }
 };
 

@@ -112,7 +112,9 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
     return;
   }
   estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
+  if (!pending_detections_.empty()) RetryPendingDetections();
   if ((estimates_.size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
+  pose_covariances_[robot_].push_back(PoseCovariance{e.time, e.frame_id, e.pose_covariance});
   SlamFactor v;
   v.kind = FactorKind::kFilterEstimate;
   v.a = OriginKey(e.frame_id);
@@ -226,7 +228,15 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
         v.z = ToPose3(g.pose.T_frame_body);
         v.information = Floored(g.covariance).inverse();
         if (Add(v)) ++report_.team_factors;
+        pose_covariances_[r].push_back(PoseCovariance{g.pose.time, g.pose.frame, g.covariance});
       }
+      if (!pending_detections_.empty()) RetryPendingDetections();
+      break;
+    }
+    case TeamInput::Kind::kDetection: {
+      TeamDetection d = in.detection;
+      d.observer_letter = r;
+      AddDetection(d, true, "");
       break;
     }
     case TeamInput::Kind::kMatch: {
@@ -256,10 +266,161 @@ void GraphStage::RetryPendingMatches() {
   report_.team_matches_pending = pending_matches_.size();
 }
 
+void GraphStage::AddDetection(const TeamDetection& detection, bool usable, const std::string& refused) {
+  detection_records_.push_back(DetectionRecord{detection, usable ? "waiting" : "refused: " + refused});
+  if (!usable) return;
+  const TeamDetection& d = detection_records_.back().detection;
+  if (d.observer_letter == 0) {
+    detection_records_.back().status = "unplaced: the observer is not in the team";
+  } else if (d.landmark ? std::find(landmarks_.begin(), landmarks_.end(), d.observed) == landmarks_.end()
+                        : d.observed_letter == 0) {
+    detection_records_.back().status = "unplaced: '" + d.observed + "' is not in the team or the landmarks";
+  } else if (d.observed_letter == d.observer_letter && !d.landmark) {
+    detection_records_.back().status = "unplaced: a robot seeing its own tag";
+  } else {
+    pending_detections_.push_back(detection_records_.size() - 1);
+    RetryPendingDetections();
+    return;
+  }
+  ++report_.detections_unplaced;
+}
+
+GraphStage::PoseLookup GraphStage::PoseAt(char robot, Timestamp time, Placed* pose, Matrix6d* covariance,
+                                          std::string* why) const {
+  const std::vector<Placed>* stream = &estimates_;
+  if (robot != robot_) {
+    const auto it = team_estimates_.find(robot);
+    if (it == team_estimates_.end()) return PoseLookup::kWait;
+    stream = &it->second;
+  }
+  if (stream->empty() || stream->back().time < time) return PoseLookup::kWait;
+  const auto after = std::lower_bound(stream->begin(), stream->end(), time,
+                                      [](const Placed& p, Timestamp t) { return p.time < t; });
+  // Estimates come at the camera rate: a gap of several frames means the filter was not running.
+  const Duration max_gap = Duration::Seconds(0.5);
+  if (after->time == time) {
+    *pose = *after;
+  } else if (after == stream->begin()) {
+    *why = std::string("no estimate of ") + robot + " before that time";
+    return PoseLookup::kNever;
+  } else {
+    const Placed& before = *(after - 1);
+    if (after->time - before.time > max_gap) {
+      *why = std::string("a gap in ") + robot + "'s estimates at that time";
+      return PoseLookup::kNever;
+    }
+    if (before.frame_id != after->frame_id) {
+      // A frame switch between the two: the nearer one, if near.
+      const Placed& near = (time - before.time) < (after->time - time) ? before : *after;
+      if (std::abs((near.time - time).seconds()) > 0.05) {
+        *why = std::string("a frame switch of ") + robot + " at that time";
+        return PoseLookup::kNever;
+      }
+      *pose = near;
+    } else {
+      const double s = (time - before.time).seconds() / (after->time - before.time).seconds();
+      pose->time = time;
+      pose->frame_id = before.frame_id;
+      pose->T_frame_body = Eigen::Isometry3d::Identity();
+      pose->T_frame_body.translation() =
+          (1.0 - s) * before.T_frame_body.translation() + s * after->T_frame_body.translation();
+      pose->T_frame_body.linear() = Eigen::Quaterniond(before.T_frame_body.linear())
+                                        .slerp(s, Eigen::Quaterniond(after->T_frame_body.linear()))
+                                        .normalized()
+                                        .toRotationMatrix();
+    }
+  }
+  // The filter's covariance in its frame changes slowly: the nearest graph pose's, same frame.
+  const auto c = pose_covariances_.find(robot);
+  const Duration window = Duration::Seconds(2.0);
+  const PoseCovariance* best = nullptr;
+  if (c != pose_covariances_.end()) {
+    for (auto it = c->second.rbegin(); it != c->second.rend(); ++it) {
+      if (it->frame_id != pose->frame_id) continue;
+      if (best == nullptr || std::abs((it->time - time).seconds()) < std::abs((best->time - time).seconds())) best = &*it;
+      if (it->time < time - window) break;
+    }
+  }
+  if (best != nullptr && std::abs((best->time - time).seconds()) <= window.seconds()) {
+    *covariance = best->covariance;
+    return PoseLookup::kReady;
+  }
+  if (c != pose_covariances_.end() && !c->second.empty() && c->second.back().time > time + window) {
+    *why = std::string("no graph pose of ") + robot + " near that time";
+    return PoseLookup::kNever;
+  }
+  return PoseLookup::kWait;
+}
+
+uint64_t GraphStage::DetectionPose(char robot, Timestamp time, const Placed& pose, const Matrix6d& covariance) {
+  // Indexed by the millisecond, apart from the filter's poses: every robot names it alike.
+  const uint64_t index = (uint64_t{1} << 47) | static_cast<uint64_t>(time.nanoseconds() / 1000000);
+  const uint64_t key = VariableKey(VariableKind::kRobotPose, robot, index);
+  if (graph_.HasVariable(key)) return key;
+  SlamFactor v;
+  v.kind = FactorKind::kFilterEstimate;
+  v.a = VariableKey(VariableKind::kSubmap, robot, pose.frame_id);
+  v.b = key;
+  v.z = ToPose3(pose.T_frame_body);
+  v.information = Floored(covariance).inverse();
+  Add(v);
+  return key;
+}
+
+void GraphStage::RetryPendingDetections() {
+  for (size_t i = 0; i < pending_detections_.size();) {
+    DetectionRecord& rec = detection_records_[pending_detections_[i]];
+    const TeamDetection& d = rec.detection;
+    Placed obs, tgt;
+    Matrix6d obs_cov, tgt_cov;
+    std::string why_a, why_b;
+    PoseLookup a = PoseAt(d.observer_letter, d.time, &obs, &obs_cov, &why_a);
+    PoseLookup b = d.landmark ? PoseLookup::kReady : PoseAt(d.observed_letter, d.time, &tgt, &tgt_cov, &why_b);
+    if (a == PoseLookup::kNever || b == PoseLookup::kNever) {
+      rec.status = "unplaced: " + (a == PoseLookup::kNever ? why_a : why_b);
+      ++report_.detections_unplaced;
+      pending_detections_.erase(pending_detections_.begin() + static_cast<long>(i));
+      continue;
+    }
+    if (a == PoseLookup::kWait || b == PoseLookup::kWait) {
+      ++i;
+      continue;
+    }
+    if (!graph_.HasVariable(VariableKey(VariableKind::kSubmap, d.observer_letter, obs.frame_id)) ||
+        (!d.landmark && !graph_.HasVariable(VariableKey(VariableKind::kSubmap, d.observed_letter, tgt.frame_id)))) {
+      ++i;  // the frame's switch factor is not in yet
+      continue;
+    }
+    SlamFactor f;
+    f.a = DetectionPose(d.observer_letter, d.time, obs, obs_cov);
+    if (d.landmark) {
+      f.kind = FactorKind::kLandmark;
+      const int index = static_cast<int>(std::find(landmarks_.begin(), landmarks_.end(), d.observed) - landmarks_.begin());
+      f.b = VariableKey(VariableKind::kLandmark, '*', static_cast<uint64_t>(index));
+    } else {
+      f.kind = FactorKind::kDetection;
+      f.b = DetectionPose(d.observed_letter, d.time, tgt, tgt_cov);
+    }
+    f.z = ToPose3(d.T_observer_observed);
+    f.information = Floored(d.covariance).inverse();
+    const size_t errors = report_.errors.size();
+    if (Add(f)) {
+      rec.status = "factor";
+      ++(d.landmark ? report_.landmark_observations : report_.detections);
+      Update();
+    } else {
+      rec.status = "graph refused: " + (report_.errors.size() > errors ? report_.errors.back() : std::string("see errors"));
+    }
+    pending_detections_.erase(pending_detections_.begin() + static_cast<long>(i));
+  }
+  report_.detections_pending = pending_detections_.size();
+}
+
 std::vector<char> GraphStage::Robots() const {
   std::vector<char> out{robot_};
   std::set<char> seen{robot_};
   for (uint64_t key : graph_.VariableKeys()) {
+    if (KindOfKey(key) == VariableKind::kLandmark) continue;
     if (seen.insert(RobotOfVariable(key)).second) out.push_back(RobotOfVariable(key));
   }
   return out;

@@ -40,6 +40,10 @@ struct GraphStageReport {
   uint64_t team_inputs = 0;      // teammates' items taken
   uint64_t team_factors = 0;     // teammates' w, v and c factors added
   uint64_t team_matches_pending = 0;  // waiting for an origin not in the graph yet
+  uint64_t detections = 0;            // robot detections d added (own and teammates')
+  uint64_t landmark_observations = 0; // landmark observations o added
+  uint64_t detections_pending = 0;    // waiting for a robot's estimates around their time
+  uint64_t detections_unplaced = 0;   // no estimate of a robot at their time: never added
   // Estimates or switches the graph could not place: their frame is not connected to the chain
   // (an input was lost upstream). Counted, never guessed.
   uint64_t unplaced = 0;
@@ -47,6 +51,12 @@ struct GraphStageReport {
   double chi2 = 0.0;             // after the final solve
   double final_cost = 0.0;
   std::vector<std::string> errors;  // the first few, verbatim
+};
+
+// A sighting the graph was given, and what became of it (OUT/detections.csv).
+struct DetectionRecord {
+  TeamDetection detection;
+  std::string status;  // "factor", "refused: ...", "waiting: ...", "unplaced: ...", "graph refused: ..."
 };
 
 // One of the robot's submap origins as the graph places it now.
@@ -75,6 +85,15 @@ class GraphStage {
   // floating subgraph until a match or detection ties it to this robot's), its estimates make its
   // global trajectory, and matches it made are added (once both origins are known).
   void OnTeamInput(const TeamInput& input);
+  // A robot detection d or landmark observation o (this robot's or a teammate's; `usable` false
+  // records it with `refused` only). Both ends become graph poses x at the detection's time, each
+  // placed by a factor v from its robot's filter estimates around that time (interpolated) with
+  // the covariance of its nearest graph pose; it waits until both robots' estimates cover the
+  // time. Landmark `observed` names are those of SetLandmarks().
+  void AddDetection(const TeamDetection& detection, bool usable, const std::string& refused);
+  // Landmark carriers by name: the index of each is its variable's.
+  void SetLandmarks(const std::vector<std::string>& names) { landmarks_ = names; }
+  const std::vector<DetectionRecord>& detections() const { return detection_records_; }
   // Every robot with variables in the graph, this one first.
   std::vector<char> Robots() const;
   // Whether `robot`'s origins are tied to this robot's prior (always for this robot).
@@ -148,6 +167,22 @@ class GraphStage {
   };
   std::vector<PendingMatch> pending_matches_;
   void RetryPendingMatches();
+  // Detections.
+  struct PoseCovariance {
+    Timestamp time;
+    uint64_t frame_id = 0;
+    Matrix6d covariance = Matrix6d::Zero();
+  };
+  std::map<char, std::vector<PoseCovariance>> pose_covariances_;  // of the graph poses, by robot
+  enum class PoseLookup { kReady, kWait, kNever };
+  // `robot`'s pose at `time` in its frame, and the covariance for its factor v.
+  PoseLookup PoseAt(char robot, Timestamp time, Placed* pose, Matrix6d* covariance, std::string* why) const;
+  // Adds the pose variable of `robot` at `time` (once) with its factor v; returns its key.
+  uint64_t DetectionPose(char robot, Timestamp time, const Placed& pose, const Matrix6d& covariance);
+  void RetryPendingDetections();
+  std::vector<std::string> landmarks_;
+  std::vector<DetectionRecord> detection_records_;
+  std::vector<size_t> pending_detections_;  // indices into detection_records_
   Matrix6d SwitchInformation(const Matrix6d& covariance, const Eigen::Isometry3d& T_old_new) const;
   std::map<uint64_t, Eigen::Matrix3d> origin_covariance_;  // of the live view, as last computed
   LatencyHistogram update_time_;

@@ -276,5 +276,164 @@ TEST(GraphStageTest, SceneShowsEveryVariableAndBinaryFactor) {
   EXPECT_GT(scene.origins[2].position_covariance.trace(), 0.0);
 }
 
+
+// A teammate's drive as the exchange hands it over: its switches and its estimates (every 5th a
+// graph pose with its covariance), in batches of `batch` estimates.
+std::vector<TeamInput> TeamInputsOf(const Drive& d, char letter, size_t batch) {
+  std::vector<TeamInput> out;
+  TeamInput poses;
+  poses.kind = TeamInput::Kind::kPoses;
+  poses.letter = letter;
+  poses.robot = std::string(1, letter);
+  uint64_t index = 0;
+  const auto flush = [&] {
+    if (!poses.poses.empty()) out.push_back(poses);
+    poses.poses.clear();
+    poses.graph_poses.clear();
+  };
+  for (const GraphInput& in : d.inputs) {
+    if (in.kind == GraphInput::Kind::kFrameSwitch) {
+      flush();
+      TeamInput w;
+      w.kind = TeamInput::Kind::kFrameSwitch;
+      w.letter = letter;
+      w.robot = poses.robot;
+      w.old_frame = in.frame_switch.old_frame_id;
+      w.new_frame = in.frame_switch.new_frame_id;
+      w.T_old_new = in.frame_switch.transform.T_old_new;
+      w.switch_covariance = in.frame_switch.transform.covariance;
+      out.push_back(w);
+      continue;
+    }
+    const TeamPose p{in.estimate.time, in.estimate.frame_id, in.estimate.T_frame_body};
+    if (poses.poses.size() % 5 == 0) poses.graph_poses.push_back(TeamGraphPose{index++, p, in.estimate.pose_covariance});
+    poses.poses.push_back(p);
+    if (poses.poses.size() >= batch) flush();
+  }
+  flush();
+  return out;
+}
+
+Eigen::Isometry3d Offset() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(2.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(5.0, -3.0, 0.4);
+  return T;
+}
+
+TeamDetection Sighting(const Drive& a, const Drive& b, size_t i, double time_shift = 0.0) {
+  TeamDetection d;
+  d.time = Timestamp::FromNanoseconds(int64_t{100000000} * static_cast<int64_t>(i) + std::llround(time_shift * 1e9));
+  d.observer = "a";
+  d.observer_letter = 'a';
+  d.observed = "b";
+  d.observed_letter = 'b';
+  d.tag_id = 10;
+  d.T_observer_observed = a.T_world_body[i].inverse() * Offset() * b.T_world_body[i];
+  d.covariance = Matrix6d::Identity() * 1e-4;
+  return d;
+}
+
+TEST(GraphStageTest, ADetectionTiesATeammatesFloatingSubgraphToOurs) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);  // its own start is its frame: Offset() away from ours
+  GraphStage g(Options(), true);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  // The detection arrives before the teammate's estimates: it waits for them.
+  g.AddDetection(Sighting(a, b, 60), true, "");
+  EXPECT_EQ(g.report().detections_pending, 1u);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 7)) g.OnTeamInput(in);
+  EXPECT_EQ(g.report().detections_pending, 0u);
+  EXPECT_EQ(g.report().detections, 1u);
+  ASSERT_TRUE(g.Connected('b'));
+  g.Finish();
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_EQ(tb.poses.size(), 100u);
+  // One sighting fixes the whole rigid subgraph: every estimate lands where it truly was.
+  for (size_t i = 0; i < tb.poses.size(); i += 9) {
+    const Eigen::Isometry3d truth = Offset() * b.T_world_body[i];
+    EXPECT_LT((tb.poses[i].T_frame_body.translation() - truth.translation()).norm(), 0.05) << i;
+  }
+  ASSERT_EQ(g.detections().size(), 1u);
+  EXPECT_EQ(g.detections()[0].status, "factor");
+}
+
+TEST(GraphStageTest, DetectionsBetweenEstimatesAreInterpolatedAndUnplaceableOnesSayWhy) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStage g(Options(), true);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 10)) g.OnTeamInput(in);
+  // Half way between two estimates (the truth at that instant interpolated the same way).
+  TeamDetection mid = Sighting(a, b, 33, 0.05);
+  const Eigen::Isometry3d Ta = a.T_world_body[33], Tb = Offset() * b.T_world_body[33];
+  const Eigen::Isometry3d Ta2 = a.T_world_body[34], Tb2 = Offset() * b.T_world_body[34];
+  const auto lerp = [](const Eigen::Isometry3d& x, const Eigen::Isometry3d& y) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.translation() = 0.5 * (x.translation() + y.translation());
+    T.linear() = Eigen::Quaterniond(x.linear()).slerp(0.5, Eigen::Quaterniond(y.linear())).toRotationMatrix();
+    return T;
+  };
+  mid.T_observer_observed = lerp(Ta, Ta2).inverse() * lerp(Tb, Tb2);
+  g.AddDetection(mid, true, "");
+  // Before the teammate's first estimate; of a robot not in the team; refused by the stage.
+  TeamDetection early = Sighting(a, b, 0, -1.0);
+  g.AddDetection(early, true, "");
+  TeamDetection stranger = Sighting(a, b, 40);
+  stranger.observed = "rover9";
+  stranger.observed_letter = 0;
+  g.AddDetection(stranger, true, "");
+  g.AddDetection(Sighting(a, b, 41), false, "farther than 12.0 m");
+  g.Finish();
+  const auto& recs = g.detections();
+  ASSERT_EQ(recs.size(), 4u);
+  EXPECT_EQ(recs[0].status, "factor");
+  EXPECT_NE(recs[1].status.find("unplaced: no estimate of a before"), std::string::npos) << recs[1].status;
+  EXPECT_NE(recs[2].status.find("rover9"), std::string::npos) << recs[2].status;
+  EXPECT_EQ(recs[3].status, "refused: farther than 12.0 m");
+  EXPECT_EQ(g.report().detections, 1u);
+  EXPECT_EQ(g.report().detections_unplaced, 2u);
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_FALSE(tb.poses.empty());
+  EXPECT_LT((tb.poses[50].T_frame_body.translation() - (Offset() * b.T_world_body[50]).translation()).norm(), 0.05);
+  // The chi2 stays that of a consistent graph (the interpolated sighting agrees with the truth).
+  EXPECT_LT(g.report().chi2, 1.0);
+}
+
+TEST(GraphStageTest, TwoRobotsSeeingTheLanderAreTiedThroughIt) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStage g(Options(), true);
+  g.SetLandmarks({"lander"});
+  Eigen::Isometry3d T_world_lander = Eigen::Isometry3d::Identity();
+  T_world_lander.translation() = Eigen::Vector3d(2.0, 4.0, 0.1);
+  T_world_lander.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 10)) g.OnTeamInput(in);
+  const auto sees = [&](char who, const Drive& d, const Eigen::Isometry3d& T_world_start, size_t i) {
+    TeamDetection s;
+    s.time = Timestamp::FromNanoseconds(int64_t{100000000} * static_cast<int64_t>(i));
+    s.observer = std::string(1, who);
+    s.observer_letter = who;
+    s.observed = "lander";
+    s.landmark = true;
+    s.tag_id = 200;
+    s.T_observer_observed = (T_world_start * d.T_world_body[i]).inverse() * T_world_lander;
+    s.covariance = Matrix6d::Identity() * 1e-4;
+    return s;
+  };
+  g.AddDetection(sees('a', a, Eigen::Isometry3d::Identity(), 20), true, "");
+  EXPECT_FALSE(g.Connected('b'));
+  g.AddDetection(sees('b', b, Offset(), 70), true, "");
+  EXPECT_TRUE(g.Connected('b'));
+  EXPECT_EQ(g.report().landmark_observations, 2u);
+  g.Finish();
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_EQ(tb.poses.size(), 100u);
+  EXPECT_LT((tb.poses[70].T_frame_body.translation() - (Offset() * b.T_world_body[70]).translation()).norm(), 0.05);
+  // The landmark is not a robot.
+  EXPECT_EQ(g.Robots(), (std::vector<char>{'a', 'b'}));
+}
+
 }  // namespace
 }  // namespace cairn

@@ -33,6 +33,8 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       switch_event_queue_(16),
       graph_queue_(static_cast<size_t>(queues.graph)),
       submap_queue_(static_cast<size_t>(queues.submaps)),
+      detection_queue_(static_cast<size_t>(queues.detection)),
+      sighting_queue_(static_cast<size_t>(queues.sightings)),
       imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
       estimation_exec_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
@@ -41,6 +43,7 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       graph_exec_("graph", executors.graph),
       graph_full_solve_exec_("graph_full_solve", executors.graph_full_solve),
       matcher_options_(executors.matcher),
+      detection_exec_("detection", executors.detection),
       imu_stats_(rates.imu_hz),
       wheel_stats_(rates.wheel_hz),
       trigger_stats_(rates.camera_hz),
@@ -59,7 +62,8 @@ Status Pipeline::EnableEstimation(const EstimationSetup& setup) {
   // Buffers for the pairs waiting in the queues, the ones in the odometry and in dense matching,
   // and the one being written.
   auto rectify =
-      StereoRectifyStage::Create(setup.stereo, rectified_queue_.capacity() + dense_queue_.capacity() + 3);
+      StereoRectifyStage::Create(setup.stereo, rectified_queue_.capacity() + dense_queue_.capacity() +
+                                                   detection_queue_.capacity() + 4);
   if (!rectify.ok()) return rectify.status().WithContext("stereo calibration");
   rectify_ = std::move(*rectify);
   vo_stage_ = std::make_unique<VoStage>(setup.vo, setup.frame_switch, rectify_->camera(), rectify_->T_body_cam());
@@ -92,6 +96,18 @@ Status Pipeline::EnableGraph(const GraphStageOptions& options) {
   return Status::Ok();
 }
 
+Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrierTable table, const std::string& robot) {
+  if (started_) return FailedPreconditionError("EnableDetection() after Start()");
+  if (!graph_) return FailedPreconditionError("robot detection needs the graph enabled");
+  if (table.empty()) return InvalidArgumentError("robot detection: the tag carrier table lists no tag");
+  if (Status s = options.detector.Validate(); !s.ok()) return s.WithContext("detection.detector");
+  graph_->SetLandmarks(table.Landmarks());
+  detection_ = std::make_unique<RobotDetectionStage>(options, std::move(table), rectify_->camera(),
+                                                     rectify_->T_body_cam(), robot, graph_->robot());
+  detection_every_ = options.every_nth_frame;
+  return Status::Ok();
+}
+
 Status Pipeline::EnableMatching(const SubmapMatchingOptions& options, const std::string& robot) {
   if (started_) return FailedPreconditionError("EnableMatching() after Start()");
   if (!mapping_ || !graph_) return FailedPreconditionError("submap matching needs mapping and the graph enabled");
@@ -106,6 +122,7 @@ Status Pipeline::SetTeamLink(TeamLink* team, std::map<char, std::string> names) 
   if (started_) return FailedPreconditionError("SetTeamLink() after Start()");
   if (!graph_) return FailedPreconditionError("the team exchange needs the graph enabled");
   team_ = team;
+  for (const auto& [letter, name] : names) letters_[name] = letter;
   if (matching_) matching_->SetTeam(std::move(names), team);
   team_->SetNotify([this] { graph_signal_.Notify(); });
   // Finished submaps travel to the team even without the matcher.
@@ -132,6 +149,7 @@ void Pipeline::Start() {
   stereo_.Start([this](std::stop_token stop) { StereoLoop(stop); });
   if (estimation_) vo_.Start([this](std::stop_token stop) { VoLoop(stop); });
   if (mapping_) mapping_exec_.Start([this](std::stop_token stop) { MappingLoop(stop); });
+  if (detection_) detection_exec_.Start([this](std::stop_token stop) { DetectionLoop(stop); });
   if (matching_) matching_->Start();
   if (graph_) graph_exec_.Start([this](std::stop_token stop) { GraphLoop(stop); });
   if (graph_ && !deterministic_) {
@@ -150,6 +168,11 @@ void Pipeline::StopAndDrain() {
     vo_.RequestStop();
     vo_signal_.Notify();
     vo_.Join();
+  }
+  if (detection_) {
+    detection_exec_.RequestStop();
+    detection_signal_.Notify();
+    detection_exec_.Join();
   }
   // Mapping after the odometry (its pairs are all in) but before the filter: in deterministic
   // mode its frame-switch requests wait for the estimation thread.
@@ -172,6 +195,7 @@ void Pipeline::StopAndDrain() {
     graph_exec_.RequestStop();
     graph_signal_.Notify();
     graph_exec_.Join();
+    if (detection_) TakeSightings(Timestamp::FromNanoseconds(INT64_MAX));
     if (team_) {
       // The last own items go out; teammates' keep coming until the team holds the same logs
       // (or the linger time is over). This thread owns the graph now.
@@ -375,6 +399,9 @@ void Pipeline::StereoLoop(std::stop_token stop) {
           if (mapping_ && dense_counter_++ % static_cast<uint64_t>(dense_every_) == 0) {
             Publish(dense_queue_, pair, mapping_signal_);
           }
+          if (detection_ && detection_counter_++ % static_cast<uint64_t>(detection_every_) == 0) {
+            Publish(detection_queue_, pair, detection_signal_);
+          }
         } else {
           ++rectify_failures_;
         }
@@ -465,6 +492,47 @@ bool Pipeline::TakeTeamInputs() {
   return any;
 }
 
+void Pipeline::DetectionLoop(std::stop_token stop) {
+  std::stop_callback wake(stop, [this] { detection_signal_.Notify(); });
+  std::vector<TagSighting> found;
+  while (true) {
+    const uint32_t seen = detection_signal_.sequence();
+    bool worked = false;
+    while (const auto* queued = detection_queue_.Front()) {
+      found.clear();
+      detection_->Process(queued->value, &found);
+      for (TagSighting& s : found) {
+        if (deterministic_) {
+          while (!sighting_queue_.TryPush(s)) std::this_thread::yield();
+        } else {
+          sighting_queue_.TryPush(s);  // a full queue counts the drop
+        }
+      }
+      if (!found.empty()) graph_signal_.Notify();
+      // Popped only now: in deterministic mode the publisher waits until the sightings are queued.
+      detection_queue_.PopFront();
+      worked = true;
+      if (deterministic_) consumed_signal_.Notify();
+    }
+    if (stop.stop_requested() && detection_queue_.empty()) return;
+    if (!worked) detection_signal_.WaitChange(seen);
+  }
+}
+
+void Pipeline::TakeSightings(Timestamp before) {
+  while (const TagSighting* s = sighting_queue_.Front()) {
+    if (!(s->detection.time < before)) return;
+    TeamDetection d = s->detection;
+    if (!d.landmark) {
+      const auto it = letters_.find(d.observed);
+      if (it != letters_.end()) d.observed_letter = it->second;
+    }
+    graph_->AddDetection(d, s->usable, s->refused);
+    if (team_ && s->usable) team_->PublishDetection(d);
+    sighting_queue_.PopFront();
+  }
+}
+
 void Pipeline::MappingLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { mapping_signal_.Notify(); });
   while (true) {
@@ -503,6 +571,9 @@ void Pipeline::GraphLoop(std::stop_token stop) {
     const uint32_t seen = graph_signal_.sequence();
     bool worked = false;
     while (const GraphInput* in = graph_queue_.Front()) {
+      // Deterministic: the sightings of the images before this estimate are in (the publisher is
+      // held until each image's detection is done), a fixed point of the data flow.
+      if (detection_ && in->kind == GraphInput::Kind::kEstimate) TakeSightings(in->estimate.time);
       graph_->OnInput(*in);
       if (team_) PublishToTeam(*in);
       // Submap k is finished before mapping asks to leave frame k + 1, so once the switch into
@@ -516,6 +587,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
         matching_->Step(*graph_);
       }
     }
+    if (detection_ && !deterministic_) TakeSightings(Timestamp::FromNanoseconds(INT64_MAX));
     if (matching_ && !deterministic_) {
       TakeSubmaps(UINT64_MAX);
       matching_->Step(*graph_);
@@ -559,6 +631,10 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
   }
   if (graph_) out.push_back(r("graph", graph_queue_));
   if (matching_) out.push_back(r("submaps", submap_queue_));
+  if (detection_) {
+    out.push_back(r("detection", detection_queue_));
+    out.push_back(r("sightings", sighting_queue_));
+  }
   return out;
 }
 
@@ -566,7 +642,8 @@ uint64_t Pipeline::total_dropped() const {
   return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
          rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
          estimate_queue_.dropped() + dense_queue_.dropped() + mapping_estimate_queue_.dropped() +
-         switch_event_queue_.dropped() + graph_queue_.dropped() + submap_queue_.dropped();
+         switch_event_queue_.dropped() + graph_queue_.dropped() + submap_queue_.dropped() + detection_queue_.dropped() +
+         sighting_queue_.dropped();
 }
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {
@@ -581,6 +658,7 @@ std::vector<ExecutorReport> Pipeline::executor_reports() const {
   if (estimation_) out.push_back(vo_.report());
   if (mapping_) out.push_back(mapping_exec_.report());
   if (graph_) out.push_back(graph_exec_.report());
+  if (detection_) out.push_back(detection_exec_.report());
   if (graph_ && !deterministic_) out.push_back(graph_full_solve_exec_.report());
   if (matching_) {
     for (const ExecutorReport& w : matching_->executor_reports()) out.push_back(w);
@@ -599,6 +677,7 @@ std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
     out.push_back(r("mapping", mapping_->map_time()));
   }
   if (graph_) out.push_back(r("graph_update", graph_->update_time()));
+  if (detection_) out.push_back(r("tag_detection", detection_->time()));
   return out;
 }
 

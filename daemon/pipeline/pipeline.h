@@ -20,6 +20,7 @@
 #include "daemon/pipeline/latency_histogram.h"
 #include "daemon/pipeline/mapping_stage.h"
 #include "daemon/pipeline/queued.h"
+#include "daemon/pipeline/robot_detection_stage.h"
 #include "daemon/pipeline/sensor_stream_stats.h"
 #include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
@@ -111,6 +112,10 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   // Matches finished submaps on the matcher pool and adds the matches to the graph (thesis 6.1).
   // Needs EnableMapping() and EnableGraph() first; call before Start().
   Status EnableMatching(const SubmapMatchingOptions& options, const std::string& robot);
+  // Detects teammates' and landmarks' tags on every `every_nth_frame`-th left rectified image
+  // (detection executor) and adds the sightings to the graph as factors d and o (and to the team).
+  // Needs EnableGraph() first; call before Start().
+  Status EnableDetection(const RobotDetectionOptions& options, TagCarrierTable table, const std::string& robot);
   // Shares this robot's frame switches, estimates, submaps and matches with the team through `team`
   // and takes teammates' items into the graph and the matcher (graph thread). Needs EnableGraph()
   // first; `team` must outlive the pipeline's threads. Call before Start().
@@ -162,6 +167,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   const std::map<char, std::map<uint64_t, std::shared_ptr<const Submap>>>& team_submaps() const {
     return team_submaps_;
   }
+  // Valid after StopAndDrain(); null when detection is not enabled.
+  const RobotDetectionStage* detection() const { return detection_.get(); }
   // Valid after StopAndDrain(); null when matching is not enabled.
   const SubmapMatchingStage* matching() const { return matching_.get(); }
   FaultReport fault_report() const;
@@ -180,6 +187,9 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void StereoLoop(std::stop_token stop);
   void VoLoop(std::stop_token stop);
   void MappingLoop(std::stop_token stop);
+  void DetectionLoop(std::stop_token stop);
+  // Graph thread: this robot's sightings up to (not including) `before` into the graph and the team.
+  void TakeSightings(Timestamp before);
   void GraphLoop(std::stop_token stop);
   void DrainEstimates();
   void TakeMappingInputs();
@@ -219,6 +229,10 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   uint64_t graph_inputs_seen_ = 0;  // estimation thread: when to wake the graph thread
   // Matching: mapping -> graph thread (finished submaps).
   SpscQueue<std::shared_ptr<const Submap>> submap_queue_;
+  // Detection: stereo -> detection (every Nth rectified pair), detection -> graph (sightings).
+  WorkSignal detection_signal_;
+  SpscQueue<Queued<RectifiedPair>> detection_queue_;
+  SpscQueue<TagSighting> sighting_queue_;
   const Duration imu_deadline_;
   std::atomic<uint64_t> deadline_misses_{0};
 
@@ -230,6 +244,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   GraphWorker graph_worker_{false};  // runs on graph_full_solve_exec_
   Executor graph_full_solve_exec_;
   ExecutorOptions matcher_options_;  // the matcher pool's workers
+  Executor detection_exec_;
 
   // Owned by the estimation thread until joined.
   SensorStreamStats imu_stats_;
@@ -252,6 +267,10 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   std::unique_ptr<MappingStage> mapping_;
   std::unique_ptr<GraphStage> graph_;
   std::unique_ptr<SubmapMatchingStage> matching_;
+  std::unique_ptr<RobotDetectionStage> detection_;
+  int64_t detection_every_ = 1;
+  uint64_t detection_counter_ = 0;  // stereo thread
+  std::map<std::string, char> letters_;  // team names -> graph letters
   GraphSceneEncoder graph_scene_;       // graph thread: the live /graph view
   uint64_t graph_shown_origins_ = 0;
   Timestamp graph_shown_time_;

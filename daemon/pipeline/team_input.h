@@ -45,8 +45,26 @@ struct TeamMatch {
   double tilt_sigma = 0.0;
 };
 
+// A robot detection d (a teammate's tag seen, thesis 6.2, eq. 4.7) or a landmark observation o
+// (the lander's): the observed carrier's body frame in the observer's body frame at the image's
+// exposure time, with its covariance [translation; rotation vector], a right perturbation of T
+// (translation in the observed carrier's axes, as the graph's residual takes it).
+struct TeamDetection {
+  Timestamp time;
+  std::string observer;  // robot names
+  char observer_letter = 0;
+  std::string observed;  // a robot's name or a landmark's
+  char observed_letter = 0;  // 0 for landmarks and robots not in the team
+  bool landmark = false;
+  int tag_id = -1;
+  Eigen::Isometry3d T_observer_observed = Eigen::Isometry3d::Identity();
+  Matrix6d covariance = Matrix6d::Identity();
+  double distance = 0.0;    // m, camera to tag
+  double view_angle = 0.0;  // rad, tag normal to the line of sight
+};
+
 struct TeamInput {
-  enum class Kind : uint8_t { kRunStart, kFrameSwitch, kPoses, kSubmap, kMatch, kAttempt };
+  enum class Kind : uint8_t { kRunStart, kFrameSwitch, kPoses, kSubmap, kMatch, kAttempt, kDetection };
   Kind kind = Kind::kRunStart;
   std::string robot;   // the item's origin
   char letter = 0;     // its graph letter (from the team file)
@@ -66,6 +84,8 @@ struct TeamInput {
   TeamMatch match;
   bool matched = false;
   std::string outcome;
+  // kDetection
+  TeamDetection detection;
 };
 
 }  // namespace cairn

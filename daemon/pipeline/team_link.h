@@ -1,6 +1,6 @@
 #pragma once
 // The graph thread's side of the team exchange: it publishes this robot's items (frame switches,
-// estimates, finished submaps, matches and attempts) and takes teammates' items in the order the
+// estimates, finished submaps, matches, attempts and detections) and takes teammates' items in the order the
 // exchange stored them. Implemented by the comms stage (daemon/comms/); thread safe.
 
 #include <functional>
@@ -21,6 +21,8 @@ class TeamLink {
   virtual void PublishSubmap(std::shared_ptr<const Submap> submap) = 0;
   virtual void PublishMatch(const TeamMatch& match) = 0;
   virtual void PublishAttempt(const TeamMatch& pair, bool matched, const std::string& outcome) = 0;
+  // A sighting of a teammate's or a landmark's tag (robot detection d, landmark observation o).
+  virtual void PublishDetection(const TeamDetection& detection) = 0;
   // Teammates' items not taken yet; false when there are none.
   virtual bool NextInput(TeamInput* input) = 0;
   // Called (from the comms thread) when inputs arrive, to wake the graph thread.

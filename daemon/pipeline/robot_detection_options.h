@@ -1,0 +1,42 @@
+#pragma once
+// `detection:` in a cairnd profile: AprilTag sightings of teammates and landmarks (thesis 6.2) on
+// the left rectified image, on the detection executor, becoming graph factors d (robot to robot)
+// and o (robot to landmark) under the Cauchy loss.
+
+#include <cstdint>
+#include <string>
+
+#include "common/options_visitor.h"
+#include "detection/tag_detector.h"
+
+namespace cairn {
+
+struct RobotDetectionOptions {
+  bool enabled = false;
+  int64_t every_nth_frame = 2;  // of the camera's frames: a whole-frame scan of each
+  // Which tag is on which robot or landmark (detection/tag_carrier_table.h); "" with `source: sim`
+  // takes the simulated world's.
+  std::string carriers_file;
+  double corner_error = 0.5;  // px, eq. 6.9's corner perturbation
+  // Sightings beyond these are kept in detections.csv but not given to the graph (thesis 6.2.3:
+  // far or edge-on tags flip between their two poses).
+  double max_distance = 12.0;          // m, camera to tag
+  double max_sigma_translation = 0.3;  // m, largest translation sigma of the tag's pose
+  double max_sigma_rotation = 1.0;     // rad, largest rotation sigma
+  bool write_csv = true;               // OUT/detections.csv
+  TagDetectorOptions detector;
+
+  void Visit(OptionsVisitor& v) {
+    v.Flag("enabled", enabled);
+    v.Integer("every_nth_frame", every_nth_frame, 1, 1000, "frames");
+    v.Text("carriers_file", carriers_file);
+    v.Number("corner_error", corner_error, 0.0, 10.0, "px");
+    v.Number("max_distance", max_distance, 0.1, 1000.0, "m");
+    v.Number("max_sigma_translation", max_sigma_translation, 1e-4, 100.0, "m");
+    v.Number("max_sigma_rotation", max_sigma_rotation, 1e-4, 3.2, "rad");
+    v.Flag("write_csv", write_csv);
+    v.Section("detector", detector);
+  }
+};
+
+}  // namespace cairn

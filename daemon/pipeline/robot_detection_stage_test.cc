@@ -1,0 +1,176 @@
+#include "daemon/pipeline/robot_detection_stage.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "detection/testing/rendered_tag.h"
+
+namespace cairn {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+RectifiedStereoCamera Camera() {
+  RectifiedStereoCamera c;
+  c.width = 1024;
+  c.height = 508;
+  c.f = 1080.0;
+  c.cx = 512.0;
+  c.cy = 254.0;
+  c.baseline = 0.3;
+  return c;
+}
+
+PinholeRadTan Pinhole() { return PinholeRadTan{1024, 508, 1080.0, 1080.0, 512.0, 254.0}; }
+
+// Camera looking along the body's x axis (z forward, x right, y down), on a mast.
+Eigen::Isometry3d BodyCam() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  T.translation() = Eigen::Vector3d(0.2, 0.0, 0.6);
+  return T;
+}
+
+// A tag facing out of the carrier's back, raised 40 deg (as on the simulated rovers' masts).
+Eigen::Isometry3d CarrierFace() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(std::numbers::pi / 2 - 40 * kDeg, Eigen::Vector3d::UnitY()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(0.08, 0.0, 0.8);
+  return T;
+}
+
+TagCarrierTable Table() {
+  TagCarrierTable t;
+  EXPECT_TRUE(t.Add(0, "rover", false, 0.16, CarrierFace()).ok());
+  EXPECT_TRUE(t.Add(10, "rover2", false, 0.16, CarrierFace()).ok());
+  Eigen::Isometry3d lander_face = Eigen::Isometry3d::Identity();
+  lander_face.linear() = (Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()) *
+                          Eigen::AngleAxisd(-std::numbers::pi / 2, Eigen::Vector3d::UnitZ()))
+                             .toRotationMatrix();  // facing +x, printed upright
+  lander_face.translation() = Eigen::Vector3d(0.81, 0.0, 0.2);
+  EXPECT_TRUE(t.Add(200, "lander", true, 0.32, lander_face).ok());
+  return t;
+}
+
+RobotDetectionOptions Options() {
+  RobotDetectionOptions o;
+  o.enabled = true;
+  o.detector.decimate = 1.0;
+  o.max_sigma_rotation = 3.0;  // a small tag's tilt is poorly known (eq. 6.9): kept, with its sigma
+  return o;
+}
+
+// The tag `id` of the table in view at T_cam_tag; returns the carrier's body in the observer's.
+Eigen::Isometry3d Observed(const TagCarrierTable& table, int id, const Eigen::Isometry3d& T_cam_tag) {
+  return BodyCam() * T_cam_tag * table.Find(id)->T_carrier_tag.inverse();
+}
+
+Eigen::Isometry3d TagInView(double distance, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()) * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(0.15, 0.05, distance);
+  return T;
+}
+
+RectifiedPair PairOf(const cv::Mat& left, int64_t time_ns) {
+  RectifiedPair p;
+  p.time = Timestamp::FromNanoseconds(time_ns);
+  p.left = testing::ImageOf(left);
+  p.right = p.left;
+  return p;
+}
+
+TEST(RobotDetectionStageTest, ATeammatesTagGivesItsBodyInOursAtTheExposureTime) {
+  const TagCarrierTable table = Table();
+  RobotDetectionStage stage(Options(), table, Camera(), BodyCam(), "hexacopter", 'b');
+  const Eigen::Isometry3d T_cam_tag = TagInView(3.0, 25 * kDeg);
+  const cv::Mat image = testing::RenderTag(10, 0.16, T_cam_tag, Pinhole());
+  std::vector<TagSighting> out;
+  stage.Process(PairOf(image, 123456789), &out);
+  ASSERT_EQ(out.size(), 1u);
+  const TeamDetection& d = out[0].detection;
+  EXPECT_TRUE(out[0].usable) << out[0].refused;
+  EXPECT_EQ(d.observer, "hexacopter");
+  EXPECT_EQ(d.observer_letter, 'b');
+  EXPECT_EQ(d.observed, "rover2");
+  EXPECT_FALSE(d.landmark);
+  EXPECT_EQ(d.tag_id, 10);
+  EXPECT_EQ(d.time.nanoseconds(), 123456789);
+  const Eigen::Isometry3d truth = Observed(table, 10, T_cam_tag);
+  const auto dev = TagPoseEstimator::Deviation(truth, d.T_observer_observed);
+  EXPECT_LT(dev.head<3>().norm(), 0.03) << dev.transpose();
+  EXPECT_LT(dev.tail<3>().norm(), 2 * kDeg) << dev.transpose();
+  EXPECT_EQ(d.covariance.llt().info(), Eigen::Success);
+  EXPECT_NEAR(d.distance, T_cam_tag.translation().norm(), 0.05);
+  EXPECT_EQ(stage.report().usable, 1u);
+}
+
+TEST(RobotDetectionStageTest, OwnTagsAreDroppedFarTagsRefusedLandmarksKept) {
+  const TagCarrierTable table = Table();
+  RobotDetectionOptions o = Options();
+  o.max_distance = 3.5;
+  RobotDetectionStage stage(o, table, Camera(), BodyCam(), "rover", 'a');
+  cv::Mat image(508, 1024, CV_8UC1, cv::Scalar(128));
+  Eigen::Isometry3d own = TagInView(2.0, 0.0);
+  own.translation().x() = -0.6;
+  Eigen::Isometry3d lander = TagInView(3.0, -20 * kDeg);
+  lander.translation().x() = 0.6;
+  testing::DrawTag(image, 0, 0.16, own, Pinhole());
+  testing::DrawTag(image, 200, 0.32, lander, Pinhole());
+  std::vector<TagSighting> out;
+  stage.Process(PairOf(image, 1), &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(out[0].detection.landmark);
+  EXPECT_EQ(out[0].detection.observed, "lander");
+  EXPECT_TRUE(out[0].usable) << out[0].refused;
+  EXPECT_EQ(stage.report().own_tags, 1u);
+
+  // The same landmark beyond the distance bound: handed on, refused with the reason.
+  const cv::Mat far = testing::RenderTag(200, 0.32, TagInView(5.0, 0.0), Pinhole());
+  out.clear();
+  stage.Process(PairOf(far, 2), &out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_FALSE(out[0].usable);
+  EXPECT_NE(out[0].refused.find("farther than 3.5 m"), std::string::npos) << out[0].refused;
+  EXPECT_EQ(stage.report().refused, 1u);
+}
+
+TEST(RobotDetectionStageTest, BadImagesAreCountedNotFatal) {
+  RobotDetectionStage stage(Options(), Table(), Camera(), BodyCam(), "rover", 'a');
+  std::vector<TagSighting> out;
+  stage.Process(RectifiedPair{}, &out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(stage.report().bad_images, 1u);
+  ASSERT_EQ(stage.report().errors.size(), 1u);
+}
+
+TEST(RobotDetectionStageTest, CarrierCovarianceIsTheFirstOrderPropagation) {
+  const Eigen::Isometry3d T_cam_tag = TagInView(2.0, 0.3);
+  const Eigen::Isometry3d T_tag_carrier = Table().Find(0)->T_carrier_tag.inverse();
+  // Columns of the Jacobian by finite differences of the decoupled right perturbation.
+  Matrix6d J;
+  const double h = 1e-6;
+  for (int k = 0; k < 6; ++k) {
+    Eigen::Matrix<double, 6, 1> delta = Eigen::Matrix<double, 6, 1>::Zero();
+    delta[k] = h;
+    Eigen::Isometry3d P = T_cam_tag;
+    P.translation() += T_cam_tag.linear() * delta.head<3>();
+    P.linear() = T_cam_tag.linear() * Eigen::AngleAxisd(delta.tail<3>().norm(), k >= 3 ? delta.tail<3>().normalized()
+                                                                                        : Eigen::Vector3d::UnitX())
+                                          .toRotationMatrix();
+    J.col(k) = TagPoseEstimator::Deviation(T_cam_tag * T_tag_carrier, P * T_tag_carrier) / h;
+  }
+  Matrix6d tag_cov = Matrix6d::Zero();
+  tag_cov.diagonal() << 1e-4, 2e-4, 9e-4, 1e-3, 4e-4, 2e-5;
+  const Matrix6d expected = J * tag_cov * J.transpose();
+  const Matrix6d got = RobotDetectionStage::CarrierCovariance(tag_cov, T_tag_carrier);
+  EXPECT_LT((got - expected).norm(), 1e-6 * expected.norm()) << got << "\n\n" << expected;
+}
+
+}  // namespace
+}  // namespace cairn
