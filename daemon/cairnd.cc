@@ -404,8 +404,15 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const 
       // Every robot the graph has tied to this one's frame, in it (eq. 4.6); the others have no
       // global trajectory here (team.json says so).
       for (const TeamMember& m : comms->team().members) {
-        const Trajectory t = graph->GlobalTrajectory(m.letter[0]);
-        if (!t.poses.empty()) CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory_" + m.name, t));
+        const char letter = m.letter[0];
+        const std::vector<uint32_t> runs = graph->Runs(letter);
+        for (uint32_t robot_run : runs) {
+          // The latest run under the robot's name; runs before a restart by their incarnation.
+          const Trajectory t = graph->GlobalTrajectory(letter, robot_run);
+          const std::string name =
+              robot_run == runs.back() ? m.name : m.name + ".run" + std::to_string(IncarnationOfRun(robot_run));
+          if (!t.poses.empty()) CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory_" + name, t));
+        }
       }
       CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/team.json", BuildTeamJson(comms->report(), comms->team(), graph)));
     }

@@ -34,6 +34,16 @@ std::string BuildTeamJson(const TeamReport& r, const TeamFile& team, const Graph
     if (graph != nullptr) {
       j.Field("origins", static_cast<uint64_t>(graph->FrameOrigins(letter).size()));
       j.Field("global_poses", static_cast<uint64_t>(graph->GlobalTrajectory(letter).poses.size()));
+      // Runs before a restart: whether each is tied in (global_trajectory_<name>.run<k>.tum).
+      const std::vector<uint32_t> runs = graph->Runs(letter);
+      j.Key("earlier_runs").BeginArray();
+      for (size_t i = 0; i + 1 < runs.size(); ++i) {
+        j.BeginObject();
+        j.Field("incarnation", static_cast<uint64_t>(IncarnationOfRun(runs[i])));
+        j.Field("connected", graph->Connected(letter, runs[i]));
+        j.EndObject();
+      }
+      j.EndArray();
     }
     j.EndObject();
   }

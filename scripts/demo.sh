@@ -3,7 +3,7 @@
 # release preset, and runs a simulated mission of a team on the default world: one cairnd per robot
 # (two rovers and a hexacopter, as on the robots), deployed from the lander (each starts in front
 # of one of its tags), talking over loopback through the team exchange with CURVE keys made for
-# the demo, each writing ./out/<robot>. Then replays the bundled real EuRoC
+# the demo, each writing ./out/<robot> ($CAIRN_DEMO_OUT/<robot>). Then replays the bundled real EuRoC
 # excerpt into ./out/euroc when the shared data sets are present.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,12 +14,13 @@ duration="${CAIRN_DEMO_DURATION:-60}"
 world="${CAIRN_DEMO_WORLD:-}"  # a world file; "" = the profiles' default world
 seed="${CAIRN_DEMO_SEED:-1}"
 port="${CAIRN_DEMO_PORT:-47701}"
+out="${CAIRN_DEMO_OUT:-out}"
 cairnd=./build/release/daemon/cairnd
 cairn=./build/release/tools/cairn
 robots=(rover hexacopter rover2)
 letters=(a b c)
 profiles=(rover hexacopter rover)
-team=out/team
+team=$out/team
 rm -rf "$team"
 mkdir -p "$team/keys"
 echo "members:" >"$team/team.yaml"
@@ -38,10 +39,10 @@ echo "demo: simulating a ${duration} s mission of ${robots[*]} on ${world:-the d
 pids=()
 for i in "${!robots[@]}"; do
   r=${robots[$i]}
-  rm -rf "out/$r/exchange"  # a new mission: no items of an earlier one
+  rm -rf "$out/$r/exchange"  # a new mission: no items of an earlier one
   "$cairnd" --config "configs/${profiles[$i]}.yaml" "${common[@]}" --set "robot.name=$r" \
     --set "graph.optimizer.own_robot=${letters[$i]}" --set "team.secret_key_file=$team/keys/$r.key" \
-    --out "out/$r" &
+    --out "$out/$r" &
   pids+=($!)
 done
 status=0
@@ -53,9 +54,9 @@ fi
 data="${CAIRN_DATA_DIR:-../shared/data}/euroc-v1_01-micro"
 if [[ -d "$data" ]]; then
   # Dense stereo and mapping on the real pairs too (off in the EuRoC profile, which tests replay).
-  "$cairnd" --config configs/euroc.yaml --replay "$data" --out out/euroc --log-level warn \
+  "$cairnd" --config configs/euroc.yaml --replay "$data" --out "$out/euroc" --log-level warn \
     --set stereo.enabled=true --set mapping.enabled=true
 else
   echo "demo: skipping the EuRoC replay: missing $data (the shared data sets next to this checkout)"
 fi
-"$cairn" summary "${robots[@]/#/out/}" $([[ -d out/euroc ]] && echo out/euroc)
+"$cairn" summary "${robots[@]/#/$out/}" $([[ -d $out/euroc ]] && echo "$out/euroc")

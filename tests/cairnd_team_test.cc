@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "estimation/eval/team_agreement.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
@@ -205,6 +206,9 @@ TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
   ASSERT_NE(rover_at_b, nullptr);
   ASSERT_NE(rover_at_a, nullptr);
   EXPECT_EQ((*rover_at_b)["items"]["run_start"].number(), 2);  // both runs
+  // The run before the kill is a run of its own in both graphs, the restarted robot's too.
+  EXPECT_EQ((*rover_at_b)["earlier_runs"].array().size(), 1u);
+  EXPECT_EQ((*rover_at_a)["earlier_runs"].array().size(), 1u);
   // The teammate holds exactly what the rover's store holds of the rover, over both runs.
   EXPECT_EQ(ItemCount(*rover_at_b), ItemCount(*rover_at_a));
   EXPECT_EQ(ItemCount(*RobotEntry(a, "hexacopter")), ItemCount(*RobotEntry(b, "hexacopter")));
@@ -305,6 +309,22 @@ TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
     const JsonValue s = JsonValue::ParseFile(out + "/summary.json");
     EXPECT_GT(s["detection"]["usable"].number(), 0) << members[i]->name;
   }
+  // Once both hold every item, their graphs agree where the team is.
+  std::vector<TeamView> views;
+  for (const Member* m : members) {
+    TeamView view{m->name, {}};
+    for (const Member* r : members) {
+      auto t = TrajectoryIo::Read(dir + "/" + m->name + "/global_trajectory_" + r->name + ".tum", TrajectoryFormat::kTum);
+      ASSERT_TRUE(t.ok()) << t.status().ToString();
+      view.robots.emplace_back(r->name, *t);
+    }
+    views.push_back(view);
+  }
+  auto agreement = CompareTeamViews(views);
+  ASSERT_TRUE(agreement.ok()) << agreement.status().ToString();
+  EXPECT_GT(agreement->compared_poses, 100);
+  EXPECT_LT(agreement->max_position, 1e-3) << agreement->worst_robot << " as " << agreement->worst_viewer << " places it";
+  EXPECT_LT(agreement->max_rotation_deg, 0.01);
 }
 
 }  // namespace

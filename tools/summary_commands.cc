@@ -12,8 +12,9 @@
 
 #include "common/json_value.h"
 #include "daemon/simulated_map_accuracy.h"
-#include "estimation/eval/trajectory.h"
+#include "estimation/eval/team_agreement.h"
 #include "estimation/eval/team_evaluator.h"
+#include "estimation/eval/trajectory.h"
 #include "estimation/eval/trajectory_evaluator.h"
 #include "tools/commands.h"
 
@@ -118,6 +119,37 @@ void PrintTeam(const std::string& dir) {
   }
 }
 
+// The team as each robot's graph places it (team.json's connected robots and their
+// global_trajectory_<robot>.tum), or nothing for a folder that is not a team member's.
+std::optional<TeamView> ReadTeamView(const std::string& dir) {
+  const std::string path = dir + "/team.json";
+  if (!std::filesystem::exists(path)) return std::nullopt;
+  const JsonValue t = JsonValue::ParseFile(path);
+  TeamView view;
+  view.viewer = std::filesystem::path(dir).filename().string();
+  for (const JsonValue& r : t["robots"].array()) {
+    if (!r["connected"].boolean()) continue;
+    const std::string name = r["name"].string();
+    auto e = TrajectoryIo::Read(dir + "/global_trajectory_" + name + ".tum", TrajectoryFormat::kTum);
+    if (e.ok()) view.robots.emplace_back(name, *e);
+  }
+  return view;
+}
+
+// Whether the team members' graphs agree where they place every robot they all connect.
+void PrintAgreement(const std::vector<TeamView>& views) {
+  if (views.size() < 2) return;
+  auto a = CompareTeamViews(views);
+  if (!a.ok()) {
+    std::printf("graph agreement: %s\n", a.status().message().c_str());
+    return;
+  }
+  std::printf("graph agreement over %d robots' graphs (one rigid alignment per graph, %d poses): max %.2f mm, "
+              "%.4f deg%s\n",
+              a->views, a->compared_poses, 1e3 * a->max_position, a->max_rotation_deg,
+              a->max_position > 0.0 ? (" (" + a->worst_robot + " as " + a->worst_viewer + " places it)").c_str() : "");
+}
+
 }  // namespace
 
 int RunSummary(const CommandArgs& args) {
@@ -126,6 +158,7 @@ int RunSummary(const CommandArgs& args) {
     return 2;
   }
   int rc = 0;
+  std::vector<TeamView> views;
   for (const char* dir : args.args) {
     const std::string path = std::string(dir) + "/summary.json";
     try {
@@ -182,11 +215,13 @@ int RunSummary(const CommandArgs& args) {
         PrintAccuracy(dir, "global_trajectory.tum", "global (graph) vs ground truth");
       if (T_world_est && s["mode"].string() == "sim") PrintMapAccuracy(dir, *T_world_est);
       PrintTeam(dir);
+      if (auto view = ReadTeamView(dir)) views.push_back(std::move(*view));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());
       rc = 1;
     }
   }
+  PrintAgreement(views);
   return rc;
 }
 

@@ -11,7 +11,6 @@ namespace cairn {
 namespace {
 
 constexpr size_t kMaxErrors = 10;
-constexpr uint64_t kIncarnationShift = 40;
 constexpr size_t kMaxBatchPoints = 512;
 
 }  // namespace
@@ -73,7 +72,17 @@ Status CommsStage::Open() {
                                          [this](const StoreItem& item) { OnItem(item); });
   report_.robot = setup_.robot;
   report_.letter = letter_;
-  // Everything already held goes to the graph again; this robot's earlier runs are counted.
+  // This run's number first: every item naming a run of this robot must know which one is current.
+  const uint8_t start_lane = LaneOf(TeamItemKind::kRunStart);
+  for (uint64_t seq = 1; seq <= store_->HighWaterMark(setup_.robot, start_lane); ++seq) {
+    auto item = store_->Read(ItemKey{setup_.robot, start_lane, seq});
+    if (!item.ok()) break;  // the replay below reports it
+    if (item->kind == static_cast<uint16_t>(TeamItemKind::kRunStart)) {
+      report_.incarnation = std::max(report_.incarnation, TeamItemCodec::IncarnationOf(*item) + 1);
+    }
+  }
+  // Everything already held goes to the graph again, this robot's earlier runs too (as runs of
+  // their own, like a teammate's), so that its graph holds what its teammates' hold.
   replaying_ = true;
   exchange_->ReplayStore();
   replaying_ = false;
@@ -87,21 +96,16 @@ void CommsStage::Error(const std::string& what) {
 void CommsStage::OnItem(const StoreItem& item) {
   report_.items[item.key.origin][TeamItemKindName(item.kind)]++;
   if (item.key.origin == setup_.robot) {
-    if (replaying_) {
-      ++report_.earlier_run_items;
-      if (item.kind == static_cast<uint16_t>(TeamItemKind::kRunStart)) {
-        report_.incarnation = std::max(report_.incarnation, TeamItemCodec::IncarnationOf(item) + 1);
-      }
-    }
-    return;  // this run's own items are in the graph already
+    if (!replaying_) return;  // this run's own items are in the graph already
+    ++report_.earlier_run_items;
   }
   TeamItemCodec::Names names;
   names.letter_of = [this](const std::string& robot) { return LetterOf(robot); };
-  names.frame_index = [this](const std::string& robot, uint32_t incarnation, uint64_t frame) {
-    // This run's own frames keep their ids (the graph knows them so); every other run's are
-    // offset by its incarnation so that runs never share a variable.
-    if (robot == setup_.robot && incarnation == report_.incarnation) return frame;
-    return (static_cast<uint64_t>(incarnation) << kIncarnationShift) | frame;
+  names.frame_index = [this](const std::string& robot, uint32_t incarnation, uint64_t index) {
+    // This run's own frames and poses keep their ids (the graph knows them so); every other run's
+    // carry it, so that runs never share a variable.
+    if (robot == setup_.robot && incarnation == report_.incarnation) return index;
+    return RunIndex(incarnation, index);
   };
   auto input = TeamItemCodec::Decode(item, names);
   if (!input.ok()) {
@@ -214,12 +218,12 @@ void CommsStage::Publish(TeamItemKind kind, std::string payload) {
 void CommsStage::SplitFrames(TeamMatch* m) const {
   // Graph frame indices back into (run, frame) as the wire names them.
   const auto split = [this](const std::string& robot, uint64_t* frame, uint32_t* incarnation) {
-    if (robot == setup_.robot && *frame < (uint64_t{1} << kIncarnationShift)) {
+    if (robot == setup_.robot && RunOfIndex(*frame) == kCurrentRun) {
       *incarnation = report_.incarnation;
       return;
     }
-    *incarnation = static_cast<uint32_t>(*frame >> kIncarnationShift);
-    *frame &= (uint64_t{1} << kIncarnationShift) - 1;
+    *incarnation = IncarnationOfRun(RunOfIndex(*frame));
+    *frame = LocalIndex(*frame);
   };
   split(m->robot_a, &m->frame_a, &m->incarnation_a);
   split(m->robot_b, &m->frame_b, &m->incarnation_b);

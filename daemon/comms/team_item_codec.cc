@@ -228,7 +228,7 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       }
       for (const auto& g : m.graph_poses()) {
         TeamGraphPose pose;
-        pose.pose_index = g.pose_index();
+        pose.pose_index = index(in.robot, m.incarnation(), g.pose_index());  // runs restart their count
         pose.pose.frame = index(in.robot, m.incarnation(), g.frame());
         pose.pose.time = Timestamp::FromNanoseconds(g.time_ns());
         CAIRN_RETURN_IF_ERROR(GetPose(g.t_frame_body(), &pose.pose.T_frame_body, &pose.covariance, what));
@@ -295,6 +295,7 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       d.time = Timestamp::FromNanoseconds(m.time_ns());
       d.observer = in.robot;
       d.observer_letter = in.letter;
+      d.observer_run = RunOfIndex(index(in.robot, m.incarnation(), 0));
       d.observed = m.observed();
       d.landmark = m.landmark();
       if (d.observed.empty() || d.observed.size() > 64) return DataLossError(what + ": names no observed robot or landmark");

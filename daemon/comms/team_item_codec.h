@@ -50,6 +50,7 @@ class TeamItemCodec {
   // file) and the index of its frame `frame` of run `incarnation`.
   struct Names {
     std::function<char(const std::string& robot)> letter_of;
+    // The graph's index of a run's frame or pose index (see RunIndex).
     std::function<uint64_t(const std::string& robot, uint32_t incarnation, uint64_t frame)> frame_index;
   };
   static Expected<TeamInput> Decode(const StoreItem& item, const Names& names);

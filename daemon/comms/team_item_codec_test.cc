@@ -62,13 +62,14 @@ TEST(TeamItemCodecTest, PoseBatchKeepsTrajectoryAndGraphPoses) {
   }
   batch[1].graph_pose = true;
   batch[1].pose_index = 42;
-  auto in = TeamItemCodec::Decode(Item("rover1", TeamItemKind::kPoseBatch, TeamItemCodec::PoseBatch(0, batch)), TestNames());
+  auto in = TeamItemCodec::Decode(Item("rover1", TeamItemKind::kPoseBatch, TeamItemCodec::PoseBatch(2, batch)), TestNames());
   ASSERT_TRUE(in.ok()) << in.status().ToString();
   ASSERT_EQ(in->poses.size(), 3u);
   ASSERT_EQ(in->graph_poses.size(), 1u);
-  EXPECT_EQ(in->graph_poses[0].pose_index, 42u);
+  // Pose indices carry the run as frames do: a restarted robot counts its poses from 0 again.
+  EXPECT_EQ(in->graph_poses[0].pose_index, (uint64_t{2} << 40) | 42);
   EXPECT_NEAR(in->poses[2].T_frame_body.translation().y(), 4.0, 1e-6);
-  EXPECT_EQ(in->poses[2].frame, 7u);
+  EXPECT_EQ(in->poses[2].frame, (uint64_t{2} << 40) | 7);
   EXPECT_NEAR(in->graph_poses[0].covariance(3, 3), 2e-4, 1e-12);
 }
 

@@ -32,6 +32,21 @@ Eigen::Isometry3d ToIsometry(const Pose3& p) {
 
 constexpr size_t kMaxErrors = 10;
 
+// Whether a decoded item of this robot's is of a run before this one (its frames carry a run).
+bool OfAnEarlierRun(const TeamInput& in) {
+  switch (in.kind) {
+    case TeamInput::Kind::kFrameSwitch:
+      return RunOfIndex(in.old_frame) != kCurrentRun;
+    case TeamInput::Kind::kPoses:
+      if (!in.poses.empty()) return RunOfIndex(in.poses.front().frame) != kCurrentRun;
+      return !in.graph_poses.empty() && RunOfIndex(in.graph_poses.front().pose.frame) != kCurrentRun;
+    case TeamInput::Kind::kDetection:
+      return in.detection.observer_run != kCurrentRun;
+    default:
+      return true;  // matches name their runs' frames themselves
+  }
+}
+
 }  // namespace
 
 GraphStage::GraphStage(const GraphStageOptions& options, bool deterministic)
@@ -114,7 +129,7 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
   estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
   if (!pending_detections_.empty()) RetryPendingDetections();
   if ((estimates_.size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
-  pose_covariances_[robot_].push_back(PoseCovariance{e.time, e.frame_id, e.pose_covariance});
+  pose_covariances_[RunKey{robot_, kCurrentRun}].push_back(PoseCovariance{e.time, e.frame_id, e.pose_covariance});
   SlamFactor v;
   v.kind = FactorKind::kFilterEstimate;
   v.a = OriginKey(e.frame_id);
@@ -205,7 +220,8 @@ Matrix6d GraphStage::SwitchInformation(const Matrix6d& covariance, const Eigen::
 void GraphStage::OnTeamInput(const TeamInput& in) {
   ++report_.team_inputs;
   const char r = in.letter;
-  if (r == 0 || r == robot_) return;  // the exchange hands this robot's own items back never
+  // This robot's current run is in the graph already; its earlier runs come as a teammate's do.
+  if (r == 0 || (r == robot_ && !OfAnEarlierRun(in))) return;
   switch (in.kind) {
     case TeamInput::Kind::kFrameSwitch: {
       SlamFactor w;
@@ -218,8 +234,7 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       break;
     }
     case TeamInput::Kind::kPoses: {
-      auto& placed = team_estimates_[r];
-      for (const TeamPose& p : in.poses) placed.push_back(Placed{p.time, p.frame, p.T_frame_body});
+      for (const TeamPose& p : in.poses) team_estimates_[RunKey{r, RunOfIndex(p.frame)}].push_back(Placed{p.time, p.frame, p.T_frame_body});
       for (const TeamGraphPose& g : in.graph_poses) {
         SlamFactor v;
         v.kind = FactorKind::kFilterEstimate;
@@ -228,7 +243,7 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
         v.z = ToPose3(g.pose.T_frame_body);
         v.information = Floored(g.covariance).inverse();
         if (Add(v)) ++report_.team_factors;
-        pose_covariances_[r].push_back(PoseCovariance{g.pose.time, g.pose.frame, g.covariance});
+        pose_covariances_[RunKey{r, RunOfIndex(g.pose.frame)}].push_back(PoseCovariance{g.pose.time, g.pose.frame, g.covariance});
       }
       if (!pending_detections_.empty()) RetryPendingDetections();
       break;
@@ -285,14 +300,52 @@ void GraphStage::AddDetection(const TeamDetection& detection, bool usable, const
   ++report_.detections_unplaced;
 }
 
-GraphStage::PoseLookup GraphStage::PoseAt(char robot, Timestamp time, Placed* pose, Matrix6d* covariance,
-                                          std::string* why) const {
-  const std::vector<Placed>* stream = &estimates_;
-  if (robot != robot_) {
-    const auto it = team_estimates_.find(robot);
-    if (it == team_estimates_.end()) return PoseLookup::kWait;
-    stream = &it->second;
+const std::vector<GraphStage::Placed>* GraphStage::Estimates(char robot, uint32_t run) const {
+  if (robot == robot_ && run == kCurrentRun) return &estimates_;
+  const auto it = team_estimates_.find(RunKey{robot, run});
+  return it == team_estimates_.end() ? nullptr : &it->second;
+}
+
+std::vector<uint32_t> GraphStage::Runs(char robot) const {
+  std::vector<uint32_t> out;
+  for (auto it = team_estimates_.lower_bound(RunKey{robot, 0}); it != team_estimates_.end() && it->first.first == robot; ++it) {
+    if (!it->second.empty()) out.push_back(it->first.second);
   }
+  if (robot == robot_) {
+    // Run 0 sorts first but is the newest.
+    out.erase(std::remove(out.begin(), out.end(), kCurrentRun), out.end());
+    out.push_back(kCurrentRun);
+  }
+  return out;
+}
+
+uint32_t GraphStage::LatestRun(char robot) const {
+  const std::vector<uint32_t> runs = Runs(robot);
+  return runs.empty() ? RunOfIndex(RunIndex(0, 0)) : runs.back();
+}
+
+uint32_t GraphStage::RunAt(char robot, Timestamp time) const {
+  // A restarted robot's clock may start over: of the runs begun by `time`, the one begun last.
+  const std::vector<uint32_t> runs = Runs(robot);
+  uint32_t best = runs.empty() ? LatestRun(robot) : runs.back();
+  bool found = false;
+  Timestamp best_start;
+  for (uint32_t run : runs) {
+    const std::vector<Placed>* s = Estimates(robot, run);
+    if (s == nullptr || s->empty() || s->front().time > time) continue;
+    if (!found || s->front().time >= best_start) {
+      best = run;
+      best_start = s->front().time;
+      found = true;
+    }
+  }
+  return best;
+}
+
+GraphStage::PoseLookup GraphStage::PoseAt(char robot, uint32_t run, Timestamp time, Placed* pose, Matrix6d* covariance,
+                                          std::string* why) const {
+  const std::vector<Placed>* stream = Estimates(robot, run);
+  if (stream == nullptr) return PoseLookup::kWait;
   if (stream->empty() || stream->back().time < time) return PoseLookup::kWait;
   const auto after = std::lower_bound(stream->begin(), stream->end(), time,
                                       [](const Placed& p, Timestamp t) { return p.time < t; });
@@ -331,7 +384,7 @@ GraphStage::PoseLookup GraphStage::PoseAt(char robot, Timestamp time, Placed* po
     }
   }
   // The filter's covariance in its frame changes slowly: the nearest graph pose's, same frame.
-  const auto c = pose_covariances_.find(robot);
+  const auto c = pose_covariances_.find(RunKey{robot, run});
   const Duration window = Duration::Seconds(2.0);
   const PoseCovariance* best = nullptr;
   if (c != pose_covariances_.end()) {
@@ -352,9 +405,12 @@ GraphStage::PoseLookup GraphStage::PoseAt(char robot, Timestamp time, Placed* po
   return PoseLookup::kWait;
 }
 
-uint64_t GraphStage::DetectionPose(char robot, Timestamp time, const Placed& pose, const Matrix6d& covariance) {
-  // Indexed by the millisecond, apart from the filter's poses: every robot names it alike.
-  const uint64_t index = (uint64_t{1} << 47) | static_cast<uint64_t>(time.nanoseconds() / 1000000);
+uint64_t GraphStage::DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose,
+                                   const Matrix6d& covariance) {
+  // Indexed by run and millisecond, apart from the filter's poses: every robot names it alike.
+  // 42 bits of milliseconds reach past 2100 in Unix time; runs wrap after 32.
+  const uint64_t ms = static_cast<uint64_t>(time.nanoseconds() / 1000000) & ((uint64_t{1} << 42) - 1);
+  const uint64_t index = (uint64_t{1} << 47) | (static_cast<uint64_t>(run & 31u) << 42) | ms;
   const uint64_t key = VariableKey(VariableKind::kRobotPose, robot, index);
   if (graph_.HasVariable(key)) return key;
   SlamFactor v;
@@ -374,8 +430,10 @@ void GraphStage::RetryPendingDetections() {
     Placed obs, tgt;
     Matrix6d obs_cov, tgt_cov;
     std::string why_a, why_b;
-    PoseLookup a = PoseAt(d.observer_letter, d.time, &obs, &obs_cov, &why_a);
-    PoseLookup b = d.landmark ? PoseLookup::kReady : PoseAt(d.observed_letter, d.time, &tgt, &tgt_cov, &why_b);
+    const uint32_t observed_run = d.landmark ? 0 : RunAt(d.observed_letter, d.time);
+    PoseLookup a = PoseAt(d.observer_letter, d.observer_run, d.time, &obs, &obs_cov, &why_a);
+    PoseLookup b = d.landmark ? PoseLookup::kReady
+                              : PoseAt(d.observed_letter, observed_run, d.time, &tgt, &tgt_cov, &why_b);
     if (a == PoseLookup::kNever || b == PoseLookup::kNever) {
       rec.status = "unplaced: " + (a == PoseLookup::kNever ? why_a : why_b);
       ++report_.detections_unplaced;
@@ -392,14 +450,14 @@ void GraphStage::RetryPendingDetections() {
       continue;
     }
     SlamFactor f;
-    f.a = DetectionPose(d.observer_letter, d.time, obs, obs_cov);
+    f.a = DetectionPose(d.observer_letter, d.observer_run, d.time, obs, obs_cov);
     if (d.landmark) {
       f.kind = FactorKind::kLandmark;
       const int index = static_cast<int>(std::find(landmarks_.begin(), landmarks_.end(), d.observed) - landmarks_.begin());
       f.b = VariableKey(VariableKind::kLandmark, '*', static_cast<uint64_t>(index));
     } else {
       f.kind = FactorKind::kDetection;
-      f.b = DetectionPose(d.observed_letter, d.time, tgt, tgt_cov);
+      f.b = DetectionPose(d.observed_letter, observed_run, d.time, tgt, tgt_cov);
     }
     f.z = ToPose3(d.T_observer_observed);
     f.information = Floored(d.covariance).inverse();
@@ -426,13 +484,16 @@ std::vector<char> GraphStage::Robots() const {
   return out;
 }
 
-bool GraphStage::Connected(char robot) const {
-  if (robot == robot_) return true;
+bool GraphStage::Connected(char robot) const { return Connected(robot, LatestRun(robot)); }
+
+bool GraphStage::Connected(char robot, uint32_t run) const {
+  if (robot == robot_ && run == kCurrentRun) return true;
   const std::vector<uint64_t> unconnected = graph_.Unconnected();
   const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
   bool any = false;
   for (uint64_t key : graph_.VariableKeys()) {
     if (RobotOfVariable(key) != robot || KindOfKey(key) != VariableKind::kSubmap) continue;
+    if (RunOfIndex(IndexOfVariable(key)) != run) continue;
     if (loose.count(key) != 0) return false;
     any = true;
   }
@@ -487,17 +548,15 @@ std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins(char robot) const
 
 Trajectory GraphStage::GlobalTrajectory() const { return GlobalTrajectory(robot_); }
 
-Trajectory GraphStage::GlobalTrajectory(char robot) const {
+Trajectory GraphStage::GlobalTrajectory(char robot) const { return GlobalTrajectory(robot, LatestRun(robot)); }
+
+Trajectory GraphStage::GlobalTrajectory(char robot, uint32_t run) const {
   Trajectory t;
   t.frame = "global";
-  if (!Connected(robot)) return t;
+  if (!Connected(robot, run)) return t;
   const auto origins = FrameOrigins(robot);
-  const std::vector<Placed>* placed = &estimates_;
-  if (robot != robot_) {
-    const auto it = team_estimates_.find(robot);
-    if (it == team_estimates_.end()) return t;
-    placed = &it->second;
-  }
+  const std::vector<Placed>* placed = Estimates(robot, run);
+  if (placed == nullptr) return t;
   t.poses.reserve(placed->size());
   for (const Placed& e : *placed) {
     const auto origin = origins.find(e.frame_id);

@@ -96,12 +96,17 @@ class GraphStage {
   const std::vector<DetectionRecord>& detections() const { return detection_records_; }
   // Every robot with variables in the graph, this one first.
   std::vector<char> Robots() const;
-  // Whether `robot`'s origins are tied to this robot's prior (always for this robot).
+  // Whether the origins of `robot`'s latest run (or of run `run`, see RunIndex) are tied to this
+  // robot's prior (always for this robot's current run).
   bool Connected(char robot) const;
+  bool Connected(char robot, uint32_t run) const;
+  // The runs of `robot` this graph has estimates of, oldest first (this robot's current run last).
+  std::vector<uint32_t> Runs(char robot) const;
   // T_global_frame of every origin of `robot` the graph holds.
   std::map<uint64_t, Eigen::Isometry3d> FrameOrigins(char robot) const;
   // `robot`'s estimates placed by its origins; empty when it is not connected (never guessed).
-  Trajectory GlobalTrajectory(char robot) const;
+  Trajectory GlobalTrajectory(char robot) const;  // its latest run
+  Trajectory GlobalTrajectory(char robot, uint32_t run) const;
   // The origins of every robot in the graph with, when `covariances`, their marginal covariances
   // (a covariance solve).
   std::vector<OriginEstimate> OriginEstimates(bool covariances);
@@ -157,7 +162,12 @@ class GraphStage {
     Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
   };
   std::vector<Placed> estimates_;
-  std::map<char, std::vector<Placed>> team_estimates_;
+  using RunKey = std::pair<char, uint32_t>;  // a robot's letter and run (see RunIndex)
+  std::map<RunKey, std::vector<Placed>> team_estimates_;  // of every run but this robot's current one
+  const std::vector<Placed>* Estimates(char robot, uint32_t run) const;
+  // The run of `robot` that was under way at `time`: of those started by then, the latest.
+  uint32_t RunAt(char robot, Timestamp time) const;
+  uint32_t LatestRun(char robot) const;
   struct PendingMatch {
     char robot_a, robot_b;
     uint64_t frame_a, frame_b;
@@ -173,12 +183,13 @@ class GraphStage {
     uint64_t frame_id = 0;
     Matrix6d covariance = Matrix6d::Zero();
   };
-  std::map<char, std::vector<PoseCovariance>> pose_covariances_;  // of the graph poses, by robot
+  std::map<RunKey, std::vector<PoseCovariance>> pose_covariances_;  // of the graph poses, by run
   enum class PoseLookup { kReady, kWait, kNever };
   // `robot`'s pose at `time` in its frame, and the covariance for its factor v.
-  PoseLookup PoseAt(char robot, Timestamp time, Placed* pose, Matrix6d* covariance, std::string* why) const;
+  PoseLookup PoseAt(char robot, uint32_t run, Timestamp time, Placed* pose, Matrix6d* covariance,
+                    std::string* why) const;
   // Adds the pose variable of `robot` at `time` (once) with its factor v; returns its key.
-  uint64_t DetectionPose(char robot, Timestamp time, const Placed& pose, const Matrix6d& covariance);
+  uint64_t DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose, const Matrix6d& covariance);
   void RetryPendingDetections();
   std::vector<std::string> landmarks_;
   std::vector<DetectionRecord> detection_records_;

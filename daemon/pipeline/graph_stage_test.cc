@@ -435,5 +435,95 @@ TEST(GraphStageTest, TwoRobotsSeeingTheLanderAreTiedThroughIt) {
   EXPECT_EQ(g.Robots(), (std::vector<char>{'a', 'b'}));
 }
 
+
+// A robot's inputs as the exchange hands over its run `incarnation`: frames and pose indices carry it.
+std::vector<TeamInput> OfRun(std::vector<TeamInput> inputs, uint32_t incarnation) {
+  for (TeamInput& in : inputs) {
+    in.old_frame = RunIndex(incarnation, in.old_frame);
+    in.new_frame = RunIndex(incarnation, in.new_frame);
+    for (TeamPose& p : in.poses) p.frame = RunIndex(incarnation, p.frame);
+    for (TeamGraphPose& g : in.graph_poses) {
+      g.pose_index = RunIndex(incarnation, g.pose_index);
+      g.pose.frame = RunIndex(incarnation, g.pose.frame);
+    }
+  }
+  return inputs;
+}
+
+// What run `run` of `observer` saw of `observed` (a robot's letter, or the lander) at estimate `i`.
+TeamDetection SeenAt(size_t i, char observer, uint32_t run, const std::string& observed, const Eigen::Isometry3d& T) {
+  TeamDetection d;
+  d.time = Timestamp::FromNanoseconds(int64_t{100000000} * static_cast<int64_t>(i));
+  d.observer = std::string(1, observer);
+  d.observer_letter = observer;
+  d.observer_run = run;
+  d.observed = observed;
+  d.landmark = observed == "lander";
+  d.observed_letter = d.landmark ? 0 : observed[0];
+  d.tag_id = d.landmark ? 200 : 11;
+  d.T_observer_observed = T;
+  d.covariance = Matrix6d::Identity() * 1e-4;
+  return d;
+}
+
+TEST(GraphStageTest, ARestartedRobotsRunsStayApartAndEachIsPlacedByItsOwnSightings) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  // b was restarted somewhere else, its clock starting over: both runs span the same times.
+  Eigen::Isometry3d restart = Offset();
+  restart.translation() += Eigen::Vector3d(-2.0, 1.5, 0.0);
+  restart.linear() = Eigen::AngleAxisd(-1.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  GraphStage g(Options(), true);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (const TeamInput& in : OfRun(TeamInputsOf(b, 'b', 10), 0)) g.OnTeamInput(in);
+  for (const TeamInput& in : OfRun(TeamInputsOf(b, 'b', 10), 1)) g.OnTeamInput(in);
+  const uint32_t first = RunOfIndex(RunIndex(0, 0)), second = RunOfIndex(RunIndex(1, 0));
+  EXPECT_EQ(g.Runs('b'), (std::vector<uint32_t>{first, second}));
+  // We see b at 6 s: the run under way then is the one begun last.
+  TeamDetection seen = Sighting(a, b, 60);
+  seen.T_observer_observed = a.T_world_body[60].inverse() * restart * b.T_world_body[60];
+  g.AddDetection(seen, true, "");
+  EXPECT_TRUE(g.Connected('b'));
+  EXPECT_FALSE(g.Connected('b', first));
+  // b's first run saw us at 3 s (an item of that run).
+  g.AddDetection(SeenAt(30, 'b', first, "a", (Offset() * b.T_world_body[30]).inverse() * a.T_world_body[30]), true, "");
+  EXPECT_TRUE(g.Connected('b', first));
+  EXPECT_EQ(g.report().detections, 2u);
+  g.Finish();
+  const Trajectory before = g.GlobalTrajectory('b', first), after = g.GlobalTrajectory('b');
+  ASSERT_EQ(before.poses.size(), 100u);
+  ASSERT_EQ(after.poses.size(), 100u);
+  for (size_t i = 0; i < 100; i += 9) {
+    EXPECT_LT((before.poses[i].T_frame_body.translation() - (Offset() * b.T_world_body[i]).translation()).norm(), 0.05) << i;
+    EXPECT_LT((after.poses[i].T_frame_body.translation() - (restart * b.T_world_body[i]).translation()).norm(), 0.05) << i;
+  }
+  EXPECT_LT(g.report().chi2, 1.0);
+}
+
+TEST(GraphStageTest, ThisRobotsEarlierRunJoinsItsGraphAsARunOfItsOwn) {
+  const Drive a = MakeDrive(100, 25);
+  GraphStage g(Options(), true);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  // The run before a restart, from this robot's store, started at Offset() in today's frame.
+  for (const TeamInput& in : OfRun(TeamInputsOf(a, 'a', 10), 0)) g.OnTeamInput(in);
+  const uint32_t earlier = RunOfIndex(RunIndex(0, 0));
+  EXPECT_EQ(g.Runs('a'), (std::vector<uint32_t>{earlier, kCurrentRun}));
+  EXPECT_FALSE(g.Connected('a', earlier));
+  EXPECT_TRUE(g.GlobalTrajectory('a', earlier).poses.empty());  // not guessed
+  ASSERT_EQ(g.GlobalTrajectory('a').poses.size(), 100u);      // today's run, as before
+  g.SetLandmarks({"lander"});
+  Eigen::Isometry3d T_world_lander = Eigen::Isometry3d::Identity();
+  T_world_lander.translation() = Eigen::Vector3d(2.0, 4.0, 0.1);
+  for (uint32_t run : {earlier, kCurrentRun}) {
+    const Eigen::Isometry3d T_world_start = run == kCurrentRun ? Eigen::Isometry3d::Identity() : Offset();
+    g.AddDetection(SeenAt(40, 'a', run, "lander", (T_world_start * a.T_world_body[40]).inverse() * T_world_lander), true, "");
+  }
+  EXPECT_TRUE(g.Connected('a', earlier));
+  g.Finish();
+  const Trajectory t = g.GlobalTrajectory('a', earlier);
+  ASSERT_EQ(t.poses.size(), 100u);
+  EXPECT_LT((t.poses[80].T_frame_body.translation() - (Offset() * a.T_world_body[80]).translation()).norm(), 0.05);
+}
+
 }  // namespace
 }  // namespace cairn

@@ -223,12 +223,13 @@ void Pipeline::StopAndDrain() {
     TakeMappingInputs();
     if (graph_) {
       const auto origins = graph_->FrameOrigins();
-      // Teammates' submaps whose robots the graph has tied to this one's frame.
+      // Teammates' submaps (and this robot's of earlier runs) whose runs the graph has tied to
+      // this one's frame.
       std::vector<PlacedSubmap> team;
       for (const auto& [letter, submaps] : team_submaps_) {
-        if (!graph_->Connected(letter)) continue;
         const auto team_origins = graph_->FrameOrigins(letter);
         for (const auto& [frame, submap] : submaps) {
+          if (!graph_->Connected(letter, RunOfIndex(frame))) continue;
           const auto o = team_origins.find(frame);
           if (o != team_origins.end()) team.push_back(PlacedSubmap{submap, o->second});
         }

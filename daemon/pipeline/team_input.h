@@ -17,6 +17,18 @@
 
 namespace cairn {
 
+// Graph indices of frames and poses carry the robot run (incarnation) they belong to in their top
+// bits, so that a robot's runs, before and after a restart, never share a variable: run 0 is this
+// robot's current run, run k + 1 any robot's incarnation k as the exchange hands it over.
+inline constexpr int kRunShift = 40;
+inline constexpr uint32_t kCurrentRun = 0;
+constexpr uint64_t RunIndex(uint32_t incarnation, uint64_t local) {
+  return (static_cast<uint64_t>(incarnation + 1) << kRunShift) | local;
+}
+constexpr uint32_t RunOfIndex(uint64_t index) { return static_cast<uint32_t>(index >> kRunShift); }
+constexpr uint32_t IncarnationOfRun(uint32_t run) { return run - 1; }
+constexpr uint64_t LocalIndex(uint64_t index) { return index & ((uint64_t{1} << kRunShift) - 1); }
+
 struct TeamPose {
   Timestamp time;
   uint64_t frame = 0;
@@ -53,6 +65,7 @@ struct TeamDetection {
   Timestamp time;
   std::string observer;  // robot names
   char observer_letter = 0;
+  uint32_t observer_run = kCurrentRun;  // which of the observer's runs saw it (see RunIndex)
   std::string observed;  // a robot's name or a landmark's
   char observed_letter = 0;  // 0 for landmarks and robots not in the team
   bool landmark = false;
