@@ -163,13 +163,38 @@ TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
       return s < 1.0 ? depth * (s8 - 1.0) + rim * s8 : rim * std::exp(-(s - 1.0) * (s - 1.0) / 0.05);
     });
   }
-  // Boulders: hemispheroids standing on the ground (positive steps).
+  // The landing site: a lander sets down on level ground, so robots deployed from it stand level
+  // in front of its tags. Flat within the radius at the height of its centre, blending into the
+  // terrain beyond (smoothstep over another half radius).
+  const bool site = o.lander.size() == 2 && o.landing_site > 0.0;
+  const double sx = site ? o.lander[0] : 0.0, sy = site ? o.lander[1] : 0.0;
+  if (site) {
+    const int cx = std::clamp(static_cast<int>(std::lround((sx + half) / res)), 0, n - 1);
+    const int cy = std::clamp(static_cast<int>(std::lround((sy + half) / res)), 0, n - 1);
+    const float level = t.heights[static_cast<size_t>(cy) * static_cast<size_t>(n) + static_cast<size_t>(cx)];
+    const double r = o.landing_site;
+    const int x0 = std::max(0, static_cast<int>(std::floor((sx - 1.5 * r + half) / res)));
+    const int x1 = std::min(n - 1, static_cast<int>(std::ceil((sx + 1.5 * r + half) / res)));
+    const int y0 = std::max(0, static_cast<int>(std::floor((sy - 1.5 * r + half) / res)));
+    const int y1 = std::min(n - 1, static_cast<int>(std::ceil((sy + 1.5 * r + half) / res)));
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) {
+        const double s = std::hypot(ix * res - half - sx, iy * res - half - sy) / r;
+        const double u = std::clamp((1.5 - s) / 0.5, 0.0, 1.0);
+        const double w = u * u * (3.0 - 2.0 * u);
+        float& h = t.heights[static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix)];
+        h = static_cast<float>((1.0 - w) * h + w * level);
+      }
+    }
+  }
+  // Boulders: hemispheroids standing on the ground (positive steps); none on the landing site.
   std::vector<Eigen::Vector4d> rocks;
   const int rock_count = static_cast<int>(std::lround(o.rock_density * hectares));
   for (int i = 0; i < rock_count; ++i) {
     const double cx = rng.Uniform(-half, half), cy = rng.Uniform(-half, half);
     const double r = o.rock_size * 0.05 * std::pow(10.0, rng.Uniform() * rng.Uniform());
     const double hr = r * rng.Uniform(0.5, 0.9);
+    if (site && std::hypot(cx - sx, cy - sy) < o.landing_site + r) continue;
     rocks.emplace_back(cx, cy, r, hr);
     Stamp(t.heights, n, half, res, cx, cy, r, 1.0, [&](double s) { return hr * std::sqrt(std::max(0.0, 1.0 - s * s)); });
   }

@@ -1,5 +1,6 @@
 #include "sim/terrain.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -188,6 +189,29 @@ TEST(TerrainTest, RaysUpIntoTheSkyMiss) {
   const Terrain t = Terrain::Generate(SmallWorld());
   EXPECT_LT(t.Raycast({0, 0, t.Height(0, 0) + 1.0}, Eigen::Vector3d(1, 0, 1).normalized(), 100).t, 0.0);
   EXPECT_LT(t.Raycast({50, 0, 5.0}, Eigen::Vector3d(1, 0, -0.1).normalized(), 100).t, 0.0);
+}
+
+TEST(TerrainTest, TheLanderStandsOnALevelBoulderFreeSite) {
+  // Seeds where the default world's lander would stand on a crater wall or among boulders.
+  for (int64_t seed : {1, 2, 3}) {
+    WorldOptions o;
+    o.seed = seed;
+    o.rock_density = 3000.0;
+    const Terrain t = Terrain::Generate(o);
+    const double x = o.lander[0], y = o.lander[1], level = t.Height(x, y);
+    double worst = 0.0;
+    for (double r = 0.2; r <= o.landing_site - 0.1; r += 0.4) {
+      for (double a = 0.0; a < 2 * M_PI; a += 0.3) worst = std::max(worst, std::abs(t.Height(x + r * std::cos(a), y + r * std::sin(a)) - level));
+    }
+    EXPECT_LT(worst, 1e-4) << "seed " << seed;
+    o.landing_site = 0.0;
+    const Terrain rough = Terrain::Generate(o);
+    double spread = 0.0;
+    for (double r = 0.2; r <= 4.9; r += 0.4) {
+      for (double a = 0.0; a < 2 * M_PI; a += 0.3) spread = std::max(spread, std::abs(rough.Height(x + r * std::cos(a), y + r * std::sin(a)) - rough.Height(x, y)));
+    }
+    EXPECT_GT(spread, 0.05) << "seed " << seed << ": without a site the ground there is not level";
+  }
 }
 
 }  // namespace

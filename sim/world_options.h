@@ -24,6 +24,9 @@ struct WorldOptions {
   double albedo_contrast = 0.35;  // relative albedo variation of the texture
   // Optional static landmark tags (e.g. on a lander): x, y of the lander, 0 or 2 values.
   std::vector<double> lander = {6.0, -4.0};
+  // Radius of the level, boulder-free ground the lander stands on (its landing site), blending
+  // into the terrain over another half of it; 0 leaves the terrain as it is.
+  double landing_site = 5.0;
   double tag_size = 0.16;         // edge of the tags' black border square
 
   void Visit(OptionsVisitor& v) {
@@ -39,6 +42,7 @@ struct WorldOptions {
     v.Number("sun_elevation", sun_elevation, 5.0, 90.0, "deg");
     v.Number("albedo_contrast", albedo_contrast, 0.0, 0.9, "");
     v.Numbers("lander", lander, 0, 2, -200.0, 200.0, "m");
+    v.Number("landing_site", landing_site, 0.0, 50.0, "m");
     v.Number("tag_size", tag_size, 0.02, 2.0, "m");
   }
   Status Validate() const {
