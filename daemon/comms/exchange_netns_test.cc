@@ -21,6 +21,7 @@
 #include "daemon/comms/exchange.h"
 #include "daemon/comms/item_store.h"
 #include "daemon/comms/zmq_transport.h"
+#include "tests/support/loopback_loss.h"
 
 namespace cairn {
 namespace {
@@ -83,16 +84,7 @@ class LossyNamespaces {
   // Packets the drop rules took, both namespaces.
   uint64_t Dropped() const {
     uint64_t total = 0;
-    for (const std::string& ns : {a_, b_}) {
-      FILE* pipe = popen(("ip netns exec " + ns + " nft list chain inet cairn_test in").c_str(), "r");
-      if (pipe == nullptr) continue;
-      char line[512];
-      while (std::fgets(line, sizeof(line), pipe) != nullptr) {
-        const char* packets = std::strstr(line, "packets ");
-        if (packets != nullptr) total += std::strtoull(packets + 8, nullptr, 10);
-      }
-      pclose(pipe);
-    }
+    for (const std::string& ns : {a_, b_}) total += testing::NftCountedPackets("ip netns exec " + ns + " nft list chain inet cairn_test in");
     return total;
   }
   const std::string& a() const { return a_; }

@@ -384,25 +384,23 @@ GraphStage::PoseLookup GraphStage::PoseAt(char robot, uint32_t run, Timestamp ti
     }
   }
   // The filter's covariance in its frame changes slowly: the nearest graph pose's, same frame.
+  // Which one is nearest is settled once a graph pose at or after `time` is in; choosing earlier
+  // would make the factor depend on when the poses arrived, and teammates' graphs differ.
   const auto c = pose_covariances_.find(RunKey{robot, run});
+  if (c == pose_covariances_.end() || c->second.empty() || c->second.back().time < time) return PoseLookup::kWait;
   const Duration window = Duration::Seconds(2.0);
   const PoseCovariance* best = nullptr;
-  if (c != pose_covariances_.end()) {
-    for (auto it = c->second.rbegin(); it != c->second.rend(); ++it) {
-      if (it->frame_id != pose->frame_id) continue;
-      if (best == nullptr || std::abs((it->time - time).seconds()) < std::abs((best->time - time).seconds())) best = &*it;
-      if (it->time < time - window) break;
-    }
+  for (auto it = c->second.rbegin(); it != c->second.rend(); ++it) {
+    if (it->frame_id != pose->frame_id) continue;
+    if (best == nullptr || std::abs((it->time - time).seconds()) < std::abs((best->time - time).seconds())) best = &*it;
+    if (it->time < time - window) break;
   }
   if (best != nullptr && std::abs((best->time - time).seconds()) <= window.seconds()) {
     *covariance = best->covariance;
     return PoseLookup::kReady;
   }
-  if (c != pose_covariances_.end() && !c->second.empty() && c->second.back().time > time + window) {
-    *why = std::string("no graph pose of ") + robot + " near that time";
-    return PoseLookup::kNever;
-  }
-  return PoseLookup::kWait;
+  *why = std::string("no graph pose of ") + robot + " near that time";
+  return PoseLookup::kNever;
 }
 
 uint64_t GraphStage::DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose,
@@ -569,11 +567,22 @@ Trajectory GraphStage::GlobalTrajectory(char robot, uint32_t run) const {
 GraphScene GraphStage::Scene(bool covariances) {
   GraphScene scene;
   std::vector<uint64_t> origin_keys;
+  const std::vector<uint64_t> unconnected = graph_.Unconnected();
+  const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
+  // A robot's latest run goes by its letter, runs before a restart by their incarnation.
+  const auto run_name = [this](char robot, uint32_t run) {
+    return run == LatestRun(robot) ? std::string(1, robot)
+                                   : std::string(1, robot) + ".run" + std::to_string(IncarnationOfRun(run));
+  };
   for (uint64_t key : graph_.VariableKeys()) {
+    if (loose.count(key) != 0) continue;  // where the graph cannot place it yet: not drawn
     auto p = graph_.Pose(key);
     if (!p.ok()) continue;
-    GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero()};
+    GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero(), ""};
     if (KindOfKey(key) == VariableKind::kSubmap) {
+      const char r = RobotOfVariable(key);
+      const uint32_t run = RunOfIndex(IndexOfVariable(key));
+      node.label = run_name(r, run) + "/s" + std::to_string(LocalIndex(IndexOfVariable(key)));
       scene.origins.push_back(node);
       origin_keys.push_back(key);
     } else {
@@ -593,6 +602,19 @@ GraphScene GraphStage::Scene(bool covariances) {
   }
   for (const SlamFactor& f : graph_.factors()) {
     if (!IsUnary(f.kind)) scene.edges.push_back(GraphScene::Edge{f.a, f.b, f.kind});
+  }
+  constexpr size_t kMaxTrackPoints = 400;
+  for (char r : Robots()) {
+    const std::vector<uint32_t> runs = Runs(r);
+    for (uint32_t run : runs) {
+      const Trajectory t = GlobalTrajectory(r, run);
+      if (t.poses.empty()) continue;
+      GraphScene::Track track{r, run_name(r, run), {}};
+      const size_t step = std::max<size_t>(1, t.poses.size() / kMaxTrackPoints);
+      for (size_t i = 0; i < t.poses.size(); i += step) track.positions.push_back(t.poses[i].T_frame_body.translation());
+      if ((t.poses.size() - 1) % step != 0) track.positions.push_back(t.poses.back().T_frame_body.translation());
+      scene.tracks.push_back(std::move(track));
+    }
   }
   return scene;
 }

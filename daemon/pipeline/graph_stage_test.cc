@@ -230,10 +230,10 @@ TEST(GraphStageTest, BadCovarianceIsRejectedAndTheGraphGoesOn) {
 
 TEST(GraphSceneEncoderTest, OriginsAreTwoSigmaEllipsoidsAndFactorsAreLines) {
   GraphScene scene;
-  GraphScene::Node s0{VariableKey(VariableKind::kSubmap, 'a', 0), Eigen::Isometry3d::Identity(), Eigen::Matrix3d::Zero()};
-  GraphScene::Node s1{VariableKey(VariableKind::kSubmap, 'a', 1), Pose(2.0, 0.0, 0.0), Eigen::Matrix3d::Zero()};
+  GraphScene::Node s0{VariableKey(VariableKind::kSubmap, 'a', 0), Eigen::Isometry3d::Identity(), Eigen::Matrix3d::Zero(), "a/s0"};
+  GraphScene::Node s1{VariableKey(VariableKind::kSubmap, 'a', 1), Pose(2.0, 0.0, 0.0), Eigen::Matrix3d::Zero(), "a/s1"};
   s1.position_covariance.diagonal() << 0.04, 0.01, 0.0;  // sigmas 0.2, 0.1, 0 m
-  GraphScene::Node x0{VariableKey(VariableKind::kRobotPose, 'a', 0), Pose(1.0, 0.5, 0.3), Eigen::Matrix3d::Zero()};
+  GraphScene::Node x0{VariableKey(VariableKind::kRobotPose, 'a', 0), Pose(1.0, 0.5, 0.3), Eigen::Matrix3d::Zero(), ""};
   scene.origins = {s0, s1};
   scene.poses = {x0};
   scene.edges = {{s0.key, s1.key, FactorKind::kFrameSwitch}, {s0.key, x0.key, FactorKind::kFilterEstimate}};
@@ -260,7 +260,26 @@ TEST(GraphSceneEncoderTest, OriginsAreTwoSigmaEllipsoidsAndFactorsAreLines) {
   EXPECT_EQ(e.lines(1).points_size(), 2);  // the pose factor
   EXPECT_NEAR(e.lines(1).points(1).y(), 0.5, 1e-12);
   ASSERT_EQ(e.texts_size(), 2);
-  EXPECT_EQ(e.texts(1).text(), "s1");
+  EXPECT_EQ(e.texts(1).text(), "a/s1");
+}
+
+TEST(GraphSceneEncoderTest, EachPlacedRobotsTrajectoryIsALineInItsColour) {
+  GraphScene scene;
+  scene.tracks = {{'a', "a", {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(1, 1, 0)}},
+                  {'b', "b.run0", {Eigen::Vector3d(5, 0, 0), Eigen::Vector3d(6, 0, 0)}}};
+  GraphSceneEncoder encoder;
+  foxglove::SceneUpdate u;
+  ASSERT_TRUE(u.ParseFromString(encoder.Encode(Timestamp::FromNanoseconds(1), 'a', scene)));
+  ASSERT_EQ(u.entities_size(), 3);
+  EXPECT_EQ(u.entities(1).id(), "trajectory/a");
+  EXPECT_EQ(u.entities(2).id(), "trajectory/b.run0");
+  ASSERT_EQ(u.entities(1).lines_size(), 1);
+  EXPECT_EQ(u.entities(1).lines(0).type(), foxglove::LinePrimitive::LINE_STRIP);
+  EXPECT_EQ(u.entities(1).lines(0).points_size(), 3);
+  EXPECT_NEAR(u.entities(1).lines(0).points(2).y(), 1.0, 1e-12);
+  const foxglove::Color& ca = u.entities(1).lines(0).color();
+  const foxglove::Color& cb = u.entities(2).lines(0).color();
+  EXPECT_FALSE(ca.r() == cb.r() && ca.g() == cb.g() && ca.b() == cb.b());
 }
 
 TEST(GraphStageTest, SceneShowsEveryVariableAndBinaryFactor) {
@@ -274,6 +293,10 @@ TEST(GraphStageTest, SceneShowsEveryVariableAndBinaryFactor) {
   // The first origin holds the prior: known to its floor; later ones less well.
   EXPECT_LT(scene.origins[0].position_covariance.trace(), scene.origins[2].position_covariance.trace());
   EXPECT_GT(scene.origins[2].position_covariance.trace(), 0.0);
+  EXPECT_EQ(scene.origins[2].label, "a/s2");
+  ASSERT_EQ(scene.tracks.size(), 1u);
+  EXPECT_EQ(scene.tracks[0].name, "a");
+  EXPECT_EQ(scene.tracks[0].positions.size(), 60u);
 }
 
 
@@ -424,8 +447,17 @@ TEST(GraphStageTest, TwoRobotsSeeingTheLanderAreTiedThroughIt) {
   };
   g.AddDetection(sees('a', a, Eigen::Isometry3d::Identity(), 20), true, "");
   EXPECT_FALSE(g.Connected('b'));
+  // The live view leaves out what the graph cannot place: b's origins, poses and trajectory.
+  const auto drawn = [](const GraphScene& scene, char robot) {
+    size_t n = 0;
+    for (const auto& o : scene.origins) n += RobotOfVariable(o.key) == robot;
+    for (const auto& t : scene.tracks) n += t.robot == robot;
+    return n;
+  };
+  EXPECT_EQ(drawn(g.Scene(false), 'b'), 0u);
   g.AddDetection(sees('b', b, Offset(), 70), true, "");
   EXPECT_TRUE(g.Connected('b'));
+  EXPECT_EQ(drawn(g.Scene(false), 'b'), 5u + 1u);  // its origins and its trajectory
   EXPECT_EQ(g.report().landmark_observations, 2u);
   g.Finish();
   const Trajectory tb = g.GlobalTrajectory('b');

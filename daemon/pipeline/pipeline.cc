@@ -493,6 +493,22 @@ bool Pipeline::TakeTeamInputs() {
   return any;
 }
 
+void Pipeline::ShowTeamSubmaps() {
+  // The joint map live: each teammate's submap once its run is tied to this robot's frame, where
+  // the graph puts its origin then.
+  for (const auto& [letter, submaps] : team_submaps_) {
+    std::map<uint64_t, Eigen::Isometry3d> origins;
+    for (const auto& [frame, submap] : submaps) {
+      if (team_submaps_shown_.count({letter, frame}) != 0 || !graph_->Connected(letter, RunOfIndex(frame))) continue;
+      if (origins.empty()) origins = graph_->FrameOrigins(letter);
+      const auto o = origins.find(frame);
+      if (o == origins.end()) continue;
+      telemetry_->OfferSubmap(submap->metadata().end, submap, o->second);
+      team_submaps_shown_.insert({letter, frame});
+    }
+  }
+}
+
 void Pipeline::DetectionLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { detection_signal_.Notify(); });
   std::vector<TagSighting> found;
@@ -605,6 +621,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       graph_shown_time_ = graph_->last_time();
       telemetry_->PublishGraph(graph_shown_time_,
                                graph_scene_.Encode(graph_shown_time_, graph_->robot(), graph_->Scene(new_origin)));
+      ShowTeamSubmaps();
     }
     // The estimation thread has stopped before this is asked: its last inputs are in the queue.
     if (stop.stop_requested() && graph_queue_.empty()) return;

@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <map>
+#include <set>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -282,6 +283,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   TelemetryStage* telemetry_ = nullptr;
   TeamLink* team_ = nullptr;
   std::map<char, std::map<uint64_t, std::shared_ptr<const Submap>>> team_submaps_;  // graph thread
+  std::set<std::pair<char, uint64_t>> team_submaps_shown_;                          // graph thread
+  void ShowTeamSubmaps();
   mutable std::mutex fault_mutex_;
   FaultReport faults_;
   bool started_ = false;

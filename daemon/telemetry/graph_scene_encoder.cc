@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "daemon/telemetry/estimate_encoder.h"
 #include "daemon/telemetry/foxglove_fields.h"
@@ -19,6 +20,14 @@ void SetColor(double r, double g, double b, double a, foxglove::Color* c) {
   c->set_g(g);
   c->set_b(b);
   c->set_a(a);
+}
+
+// One colour per robot letter, so that a team's graph reads at a glance.
+void SetRobotColor(char robot, double alpha, foxglove::Color* c) {
+  static constexpr double kPalette[][3] = {{0.95, 0.55, 0.1}, {0.3, 0.8, 0.3}, {0.75, 0.4, 0.95},
+                                           {0.95, 0.85, 0.2}, {0.95, 0.35, 0.45}, {0.3, 0.85, 0.85}};
+  const auto& rgb = kPalette[static_cast<unsigned char>(robot) % std::size(kPalette)];
+  SetColor(rgb[0], rgb[1], rgb[2], alpha, c);
 }
 
 void AddPoint(const Eigen::Vector3d& p, foxglove::LinePrimitive* line) {
@@ -60,7 +69,7 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
     s->mutable_size()->set_x(d.x());
     s->mutable_size()->set_y(d.y());
     s->mutable_size()->set_z(d.z());
-    SetColor(0.95, 0.55, 0.1, 0.6, s->mutable_color());
+    SetRobotColor(RobotOfVariable(n.key), 0.6, s->mutable_color());
     foxglove::TextPrimitive* t = e->add_texts();
     Eigen::Isometry3d label = Eigen::Isometry3d::Identity();
     label.translation() = n.T_global.translation() + Eigen::Vector3d(0.0, 0.0, 0.15);
@@ -69,7 +78,7 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
     t->set_font_size(14.0);
     t->set_scale_invariant(true);
     SetColor(1.0, 1.0, 1.0, 1.0, t->mutable_color());
-    t->set_text("s" + std::to_string(IndexOfVariable(n.key)));
+    t->set_text(n.label.empty() ? "s" + std::to_string(IndexOfVariable(n.key)) : n.label);
   }
   for (const GraphScene::Node& n : scene.poses) {
     position[n.key] = n.T_global.translation();
@@ -97,6 +106,20 @@ const std::string& GraphSceneEncoder::Encode(Timestamp time, char robot, const G
     foxglove::LinePrimitive* l = edge.kind == FactorKind::kFilterEstimate ? legs : chain;
     AddPoint(a->second, l);
     AddPoint(b->second, l);
+  }
+  // Every robot's trajectory as this robot's graph places it, in its robot's colour.
+  for (const GraphScene::Track& track : scene.tracks) {
+    foxglove::SceneEntity* t = update.add_entities();
+    SetFoxgloveTime(time, t->mutable_timestamp());
+    t->set_frame_id(EstimateEncoder::kMapFrame);
+    t->set_id("trajectory/" + track.name);
+    foxglove::LinePrimitive* line = t->add_lines();
+    line->set_type(foxglove::LinePrimitive::LINE_STRIP);
+    line->mutable_pose()->mutable_orientation()->set_w(1.0);
+    line->set_scale_invariant(true);
+    line->set_thickness(2.0);
+    SetRobotColor(track.robot, 1.0, line->mutable_color());
+    for (const Eigen::Vector3d& p : track.positions) AddPoint(p, line);
   }
   out_ = update.SerializeAsString();
   return out_;
