@@ -111,7 +111,7 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   EXPECT_EQ(graph["schema"].string(), "foxglove.SceneUpdate");
   EXPECT_GT(graph["count"].number(), 0);
   EXPECT_EQ(graph["decodeErrors"].number(), 0);
-  EXPECT_EQ(graph["lastGraph"]["entities"].number(), 1);
+  EXPECT_EQ(graph["lastGraph"]["entities"].number(), 2);  // the graph and the robot's trajectory
   EXPECT_EQ(graph["lastGraph"]["id"].string(), "graph/a");
   EXPECT_EQ(graph["lastGraph"]["frame"].string(), "map");
   EXPECT_GE(graph["lastGraph"]["spheres"].number(), 2);  // the first origin and a robot pose at least
