@@ -409,8 +409,7 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const 
         for (uint32_t robot_run : runs) {
           // The latest run under the robot's name; runs before a restart by their incarnation.
           const Trajectory t = graph->GlobalTrajectory(letter, robot_run);
-          const std::string name =
-              robot_run == runs.back() ? m.name : m.name + ".run" + std::to_string(IncarnationOfRun(robot_run));
+          const std::string name = m.name + (robot_run == runs.back() ? "" : EarlierRunSuffix(robot_run));
           if (!t.poses.empty()) CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory_" + name, t));
         }
       }

@@ -61,6 +61,18 @@ void WriteTeam(const std::string& path, const std::vector<Member>& members, cons
   }
 }
 
+// A key pair per name in `keys_dir` (created), as `cairn keys generate` makes them.
+void GenerateKeys(const std::string& keys_dir, const std::vector<std::string>& names) {
+  fs::create_directories(keys_dir);
+  for (const std::string& name : names) {
+    const ProcessResult r = RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys_dir});
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+}
+
+// Ports of this test process (`slot` 0-7 of its block), apart from other tests' processes.
+int TeamPort(int slot) { return 20000 + static_cast<int>(getpid() % 2000) * 8 + slot; }
+
 std::vector<std::string> TeamArgs(const Member& m, const std::string& team_file, const std::string& key_file,
                                   const std::string& out, double duration = 6.0) {
   return {Cairnd(), "--config", Config(m.profile), "--sim", "--out", out,
@@ -84,18 +96,13 @@ TEST(CairndTeamTest, TwoRobotsHoldEachOthersItemsOnceAndAnIntruderGetsNothing) {
   const std::string dir = testing::FreshTempDir("cairnd_team");
   const std::string keys = dir + "/keys";
   const std::string intruder_keys = dir + "/intruder_keys";
-  fs::create_directories(keys);
-  fs::create_directories(intruder_keys);
-  for (const std::string name : {"rover", "hexacopter"}) {
-    const ProcessResult r = RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys});
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-  }
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
   // The intruder knows the team's addresses and public keys, but its own key is not listed.
-  ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", "rover2", "--dir", intruder_keys}).exit_code, 0);
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(intruder_keys, {"rover2"}));
   for (const std::string name : {"rover", "hexacopter"}) {
     fs::copy_file(keys + "/" + name + ".pub", intruder_keys + "/" + name + ".pub");
   }
-  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8;
+  const int base = TeamPort(0);
   const Member rover{"rover", "a", "rover", base};
   const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
   const Member intruder{"rover2", "c", "rover", base + 2};
@@ -105,15 +112,15 @@ TEST(CairndTeamTest, TwoRobotsHoldEachOthersItemsOnceAndAnIntruderGetsNothing) {
   testing::ProcessOptions options;
   options.timeout = std::chrono::minutes(8);
   ProcessResult results[3];
-  std::vector<std::thread> runs;
-  runs.emplace_back([&] {
+  std::thread runs[3];
+  runs[0] = std::thread([&] {
     results[0] = RunProcess(TeamArgs(rover, dir + "/team.yaml", keys + "/rover.key", dir + "/rover"), options);
   });
-  runs.emplace_back([&] {
+  runs[1] = std::thread([&] {
     results[1] = RunProcess(TeamArgs(hexacopter, dir + "/team.yaml", keys + "/hexacopter.key", dir + "/hexacopter"),
                             options);
   });
-  runs.emplace_back([&] {
+  runs[2] = std::thread([&] {
     // It never settles (nobody answers): a short linger.
     auto args = TeamArgs(intruder, dir + "/intruder.yaml", intruder_keys + "/rover2.key", dir + "/rover2");
     args.push_back("--set");
@@ -193,11 +200,8 @@ double ItemCount(const JsonValue& robot) {
 TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
   const std::string dir = testing::FreshTempDir("cairnd_team_kill");
   const std::string keys = dir + "/keys";
-  fs::create_directories(keys);
-  for (const std::string name : {"rover", "hexacopter"}) {
-    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys}).exit_code, 0);
-  }
-  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8 + 4;
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
+  const int base = TeamPort(4);
   const Member rover{"rover", "a", "rover", base};
   const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
   WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
@@ -260,11 +264,8 @@ TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
     ~Unmount() { RunProcess({"/usr/bin/umount", path}); }
   } unmount{store};
   const std::string keys = dir + "/keys";
-  fs::create_directories(keys);
-  for (const std::string name : {"rover", "hexacopter"}) {
-    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys}).exit_code, 0);
-  }
-  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8 + 6;
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
+  const int base = TeamPort(6);
   const Member rover{"rover", "a", "rover", base};
   const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
   WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
@@ -293,11 +294,8 @@ TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
 TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
   const std::string dir = testing::FreshTempDir("cairnd_team_lander");
   const std::string keys = dir + "/keys";
-  fs::create_directories(keys);
-  for (const std::string name : {"rover", "hexacopter"}) {
-    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", name, "--dir", keys}).exit_code, 0);
-  }
-  const int base = 20000 + static_cast<int>(getpid() % 2000) * 8 + 4;
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
+  const int base = TeamPort(4);
   const Member rover{"rover", "a", "rover", base};
   const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
   WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
@@ -365,12 +363,9 @@ TEST(CairndTeamTest, FaultsAllInOneRunLoseNothingAndTheGraphsAgreeAfterHealing) 
   if (!loss.why_not().empty()) GTEST_SKIP() << loss.why_not();
   const std::string dir = testing::FreshTempDir("cairnd_team_faults");
   const std::string keys = dir + "/keys";
-  fs::create_directories(keys);
   const std::vector<Member> team = {{"rover", "a", "rover", base}, {"hexacopter", "b", "hexacopter", base + 1},
                                     {"rover2", "c", "rover", base + 2}};
-  for (const Member& m : team) {
-    ASSERT_EQ(RunProcess({Cairn(), "keys", "generate", "--name", m.name, "--dir", keys}).exit_code, 0);
-  }
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter", "rover2"}));
   // Robot x reaches robot y only through its own link x -> y, so each has a team file of its own.
   std::map<std::pair<int, int>, std::unique_ptr<testing::TcpLinkProxy>> links;
   for (int x = 0; x < kRobots; ++x) {

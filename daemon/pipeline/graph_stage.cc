@@ -32,21 +32,6 @@ Eigen::Isometry3d ToIsometry(const Pose3& p) {
 
 constexpr size_t kMaxErrors = 10;
 
-// Whether a decoded item of this robot's is of a run before this one (its frames carry a run).
-bool OfAnEarlierRun(const TeamInput& in) {
-  switch (in.kind) {
-    case TeamInput::Kind::kFrameSwitch:
-      return RunOfIndex(in.old_frame) != kCurrentRun;
-    case TeamInput::Kind::kPoses:
-      if (!in.poses.empty()) return RunOfIndex(in.poses.front().frame) != kCurrentRun;
-      return !in.graph_poses.empty() && RunOfIndex(in.graph_poses.front().pose.frame) != kCurrentRun;
-    case TeamInput::Kind::kDetection:
-      return in.detection.observer_run != kCurrentRun;
-    default:
-      return true;  // matches name their runs' frames themselves
-  }
-}
-
 }  // namespace
 
 GraphStage::GraphStage(const GraphStageOptions& options, bool deterministic)
@@ -220,8 +205,8 @@ Matrix6d GraphStage::SwitchInformation(const Matrix6d& covariance, const Eigen::
 void GraphStage::OnTeamInput(const TeamInput& in) {
   ++report_.team_inputs;
   const char r = in.letter;
-  // This robot's current run is in the graph already; its earlier runs come as a teammate's do.
-  if (r == 0 || (r == robot_ && !OfAnEarlierRun(in))) return;
+  // The exchange hands over this robot's earlier runs (as a teammate's), never its current one.
+  if (r == 0) return;
   switch (in.kind) {
     case TeamInput::Kind::kFrameSwitch: {
       SlamFactor w;
@@ -571,8 +556,7 @@ GraphScene GraphStage::Scene(bool covariances) {
   const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
   // A robot's latest run goes by its letter, runs before a restart by their incarnation.
   const auto run_name = [this](char robot, uint32_t run) {
-    return run == LatestRun(robot) ? std::string(1, robot)
-                                   : std::string(1, robot) + ".run" + std::to_string(IncarnationOfRun(run));
+    return std::string(1, robot) + (run == LatestRun(robot) ? "" : EarlierRunSuffix(run));
   };
   for (uint64_t key : graph_.VariableKeys()) {
     if (loose.count(key) != 0) continue;  // where the graph cannot place it yet: not drawn

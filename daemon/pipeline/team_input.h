@@ -28,6 +28,8 @@ constexpr uint64_t RunIndex(uint32_t incarnation, uint64_t local) {
 constexpr uint32_t RunOfIndex(uint64_t index) { return static_cast<uint32_t>(index >> kRunShift); }
 constexpr uint32_t IncarnationOfRun(uint32_t run) { return run - 1; }
 constexpr uint64_t LocalIndex(uint64_t index) { return index & ((uint64_t{1} << kRunShift) - 1); }
+// How outputs name a robot's run before its latest: ".run<incarnation>".
+inline std::string EarlierRunSuffix(uint32_t run) { return ".run" + std::to_string(IncarnationOfRun(run)); }
 
 struct TeamPose {
   Timestamp time;
