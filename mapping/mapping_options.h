@@ -117,6 +117,12 @@ struct SubmapOptions {
   double log_odds_miss = -0.4;
   double log_odds_min = -2.0;
   double log_odds_max = 3.5;
+  // Position of a point inside its voxel on the wire, per axis: 2 bits put it within
+  // resolution / 8, far below the stereo scatter of the centroids, and halve the bytes of 4 bits.
+  int64_t wire_offset_bits = 2;
+  // Intensity or colour on the wire, per channel: 6 bits (steps of 4 grey levels) are below the
+  // cameras' noise and take about 2 bits per point less than 8 (exact).
+  int64_t wire_intensity_bits = 6;
 
   void Visit(OptionsVisitor& v) {
     v.Number("cloud_resolution", cloud_resolution, 0.005, 1.0, "m");
@@ -125,6 +131,8 @@ struct SubmapOptions {
     v.Number("log_odds_miss", log_odds_miss, -10.0, -0.01, "");
     v.Number("log_odds_min", log_odds_min, -20.0, -0.01, "");
     v.Number("log_odds_max", log_odds_max, 0.01, 20.0, "");
+    v.Integer("wire_offset_bits", wire_offset_bits, 1, 4, "bits per axis");
+    v.Integer("wire_intensity_bits", wire_intensity_bits, 1, 8, "bits per channel");
   }
 };
 

@@ -16,7 +16,8 @@ obstacles: {edge_jump: 0.2, edge_jump_sigmas: 3.0, max_slope: 0.5, edge_max_gap_
             min_cell_points: 3}
 rolling_map: {cell_size: 0.05, cells: 400, low_pass: 0.3}
 submap: {cloud_resolution: 0.05, octree_resolution: 0.1, log_odds_hit: 0.85, log_odds_miss: -0.4,
-         log_odds_min: -2.0, log_odds_max: 3.5}
+         log_odds_min: -2.0, log_odds_max: 3.5, wire_offset_bits: 3,
+         wire_intensity_bits: 7}
 partition: {max_position_sigma: 0.2, max_distance: 7.0, retry_interval: 1.0}
 composition: {cloud_resolution: 0.05, rebuild_translation: 0.02, rebuild_rotation_deg: 0.2}
 )";
@@ -33,6 +34,8 @@ TEST(MappingOptionsTest, LoadsFromYamlAndNamesBadKeys) {
   EXPECT_TRUE(o.fusion.enabled);
   EXPECT_DOUBLE_EQ(o.fusion.agreement_sigmas, 2.5);
   EXPECT_EQ(o.fusion.max_images, 8);
+  EXPECT_EQ(o.submap.wire_offset_bits, 3);
+  EXPECT_EQ(o.submap.wire_intensity_bits, 7);
 
   YAML::Node bad = YAML::Load(kYaml);
   bad["obstacles"]["window_cells"] = 9;      // outside 3..6

@@ -17,7 +17,7 @@ namespace {
 
 constexpr char kMagic[8] = {'C', 'A', 'I', 'R', 'N', 'S', 'U', 'B'};
 constexpr uint64_t kMaxPayload = uint64_t{1} << 30;
-constexpr int kOffsetSteps = 16;
+constexpr int kMaxSections = 16;
 constexpr int kTreeDepth = 16;
 // zstd level of the body: a submap is sent over a poor radio link, but it is encoded on the mapping
 // thread, where level 9 took up to 0.4 s for a hexacopter submap for about 2 % less size.
@@ -76,7 +76,8 @@ class ChannelPredictor {
       if (j < i && keys[j] == target) out[a] = static_cast<int64_t>(j);
     }
   }
-  static uint8_t Predict(const uint8_t* channel, const int64_t nb[3]) {
+  // `none`: the prediction without neighbours (mid-range).
+  static uint8_t Predict(const uint8_t* channel, const int64_t nb[3], uint8_t none) {
     int sum = 0, n = 0;
     for (int a = 0; a < 3; ++a) {
       if (nb[a] >= 0) {
@@ -84,7 +85,7 @@ class ChannelPredictor {
         ++n;
       }
     }
-    return static_cast<uint8_t>(n == 0 ? 128 : (sum + n / 2) / n);
+    return static_cast<uint8_t>(n == 0 ? none : (sum + n / 2) / n);
   }
 
  private:
@@ -96,6 +97,12 @@ Status CheckOptions(const SubmapOptions& o) {
   const auto bad = [](double v, double lo, double hi) { return !(v >= lo && v <= hi); };
   if (bad(o.cloud_resolution, 0.001, 10.0) || bad(o.octree_resolution, 0.001, 10.0)) {
     return DataLossError("submap resolutions out of range");
+  }
+  if (o.wire_offset_bits < 1 || o.wire_offset_bits > 4) {
+    return DataLossError("submap offset bits " + std::to_string(o.wire_offset_bits) + " outside 1..4");
+  }
+  if (o.wire_intensity_bits < 1 || o.wire_intensity_bits > 8) {
+    return DataLossError("submap intensity bits " + std::to_string(o.wire_intensity_bits) + " outside 1..8");
   }
   if (bad(o.log_odds_hit, 0.0, 100.0) || bad(o.log_odds_miss, -100.0, 0.0) ||
       bad(o.log_odds_min, -100.0, 0.0) || bad(o.log_odds_max, 0.0, 100.0)) {
@@ -149,10 +156,22 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   F64(w, m.options.log_odds_miss);
   F64(w, m.options.log_odds_min);
   F64(w, m.options.log_odds_max);
+  w.U8(static_cast<uint8_t>(m.options.wire_offset_bits));
+  w.U8(static_cast<uint8_t>(m.options.wire_intensity_bits));
 
   // Cloud: voxel index and in-voxel offset of every point, sorted by index.
   const std::vector<CloudPoint>& pts = submap.points();
   const double res = m.options.cloud_resolution;
+  const int offset_bits = static_cast<int>(m.options.wire_offset_bits);
+  if (offset_bits < 1 || offset_bits > 4) {
+    return InvalidArgumentError("submap wire_offset_bits " + std::to_string(offset_bits) + " outside 1..4");
+  }
+  const int steps = 1 << offset_bits;
+  const int intensity_bits = static_cast<int>(m.options.wire_intensity_bits);
+  if (intensity_bits < 1 || intensity_bits > 8) {
+    return InvalidArgumentError("submap wire_intensity_bits " + std::to_string(intensity_bits) + " outside 1..8");
+  }
+  const int drop = 8 - intensity_bits;
   struct Q {
     uint64_t linear;
     int64_t d[3];  // cell in the extent
@@ -179,7 +198,7 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
                       static_cast<uint64_t>(extent.x()) + static_cast<uint64_t>(d.x());
     for (int a = 0; a < 3; ++a) {
       const double f = pts[i].p[a] / res - cells[i][a];
-      q[i].off[a] = static_cast<uint8_t>(std::clamp(static_cast<int>(f * kOffsetSteps), 0, kOffsetSteps - 1));
+      q[i].off[a] = static_cast<uint8_t>(std::clamp(static_cast<int>(f * steps), 0, steps - 1));
     }
     q[i].p = &pts[i];
     color |= pts[i].r != pts[i].g || pts[i].r != pts[i].b;
@@ -196,18 +215,29 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
     prev = q[i].linear;
   }
   w.U32(static_cast<uint32_t>(stream.size()));
+  // Each stream is compressed on its own (sections): their statistics differ too much to share
+  // one entropy coder (one zstd frame over all of them is about 10 % larger).
+  std::vector<size_t> cuts = {0, w.size()};
   w.Bytes(stream);
-  // Separate streams per field compress far better than interleaved records.
-  for (const Q& e : q) w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << 4)));
-  for (const Q& e : q) w.U8(e.off[2]);
+  cuts.push_back(w.size());
+  // Separate streams per field compress far better than interleaved records; up to 2 bits per
+  // axis one byte holds all three offsets.
+  if (3 * offset_bits <= 8) {
+    for (const Q& e : q) w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << offset_bits) | (e.off[2] << (2 * offset_bits))));
+  } else {
+    for (const Q& e : q) w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << 4)));
+    cuts.push_back(w.size());
+    for (const Q& e : q) w.U8(e.off[2]);
+  }
+  cuts.push_back(w.size());
   // Channels as residuals of their prediction (the decoder predicts from what it decoded).
   const int channels = color ? 3 : 1;
   std::vector<uint8_t> values(static_cast<size_t>(channels) * q.size()), residuals(values.size());
   for (size_t i = 0; i < q.size(); ++i) {
-    values[i] = q[i].p->r;
+    values[i] = static_cast<uint8_t>(q[i].p->r >> drop);
     if (color) {
-      values[q.size() + i] = q[i].p->g;
-      values[2 * q.size() + i] = q[i].p->b;
+      values[q.size() + i] = static_cast<uint8_t>(q[i].p->g >> drop);
+      values[2 * q.size() + i] = static_cast<uint8_t>(q[i].p->b >> drop);
     }
   }
   ChannelPredictor predictor(extent);
@@ -218,21 +248,35 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
     predictor.Neighbours(keys, i, q[i].d, nb);
     for (int c = 0; c < channels; ++c) {
       const uint8_t* channel = values.data() + c * q.size();
-      residuals[c * q.size() + i] = static_cast<uint8_t>(channel[i] - ChannelPredictor::Predict(channel, nb));
+      residuals[c * q.size() + i] = static_cast<uint8_t>(channel[i] - ChannelPredictor::Predict(channel, nb, 128 >> drop));
     }
   }
   w.Bytes(residuals);
+  cuts.push_back(w.size());
   std::vector<uint8_t> bits((q.size() + 7) / 8, 0);
   for (size_t i = 0; i < q.size(); ++i) {
     if (q[i].p->obstacle) bits[i / 8] |= static_cast<uint8_t>(1u << (i % 8));
   }
   w.Bytes(bits);
+  cuts.push_back(w.size());
   const std::string tree = TreeBinary(submap.tree());
   w.U64(tree.size());
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(tree.data()), tree.size()));
 
-  std::vector<uint8_t> compressed;
-  CAIRN_RETURN_IF_ERROR(Compressor::Compress(compression, w.buffer(), &compressed, kZstdLevel));
+  cuts.push_back(w.size());
+  if (w.size() > kMaxPayload) return InvalidArgumentError("submap larger than " + std::to_string(kMaxPayload) + " bytes");
+  // Body: section count, (raw size, packed size) per section, then the packed sections.
+  ByteWriter body;
+  body.U8(static_cast<uint8_t>(cuts.size() - 1));
+  std::vector<std::vector<uint8_t>> packed(cuts.size() - 1);
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const std::span<const uint8_t> section(w.buffer().data() + cuts[i], cuts[i + 1] - cuts[i]);
+    CAIRN_RETURN_IF_ERROR(Compressor::Compress(compression, section, &packed[i], kZstdLevel));
+    body.U32(static_cast<uint32_t>(section.size()));
+    body.U32(static_cast<uint32_t>(packed[i].size()));
+  }
+  for (const std::vector<uint8_t>& p : packed) body.Bytes(p);
+  const std::vector<uint8_t>& compressed = body.buffer();
   ByteWriter out;
   out.Bytes(std::span(reinterpret_cast<const uint8_t*>(kMagic), sizeof(kMagic)));
   out.U16(kVersion);
@@ -261,7 +305,7 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   const uint32_t packed_crc = h.U32();
   if (h.failed()) return DataLossError("submap header truncated");
   if (version != kVersion) {
-    // Version 1 (raw intensity/colour) is not read any more: robots of a team run one version.
+    // Earlier versions are not read any more: robots of a team run one version.
     return DataLossError("submap format version " + std::to_string(version) + " is not supported (expected " +
                          std::to_string(kVersion) + ")");
   }
@@ -273,9 +317,30 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   }
   const auto packed = h.Take(packed_size);
   if (Crc32::Of(packed) != packed_crc) return DataLossError("submap checksum mismatch (compressed body)");
-  std::vector<uint8_t> raw;
-  const Status st = Compressor::Decompress(static_cast<Compression>(compression), packed, raw_size, &raw);
-  if (!st.ok()) return DataLossError("submap body does not decompress: " + st.message());
+  ByteReader sections(packed);
+  const uint8_t count = sections.U8();
+  if (sections.failed() || count == 0 || count > kMaxSections) {
+    return DataLossError("submap body has " + std::to_string(count) + " sections (1.." + std::to_string(kMaxSections) + ")");
+  }
+  std::vector<std::pair<uint32_t, uint32_t>> table(count);
+  uint64_t raw_total = 0, packed_total = 0;
+  for (auto& [raw_bytes, packed_bytes] : table) {
+    raw_bytes = sections.U32();
+    packed_bytes = sections.U32();
+    raw_total += raw_bytes;
+    packed_total += packed_bytes;
+  }
+  if (sections.failed() || raw_total != raw_size || packed_total != sections.remaining()) {
+    return DataLossError("submap section table does not match the body");
+  }
+  std::vector<uint8_t> raw, section;
+  raw.reserve(raw_size);
+  for (size_t i = 0; i < table.size(); ++i) {
+    const Status st = Compressor::Decompress(static_cast<Compression>(compression), sections.Take(table[i].second),
+                                             table[i].first, &section);
+    if (!st.ok()) return DataLossError("submap section " + std::to_string(i) + " does not decompress: " + st.message());
+    raw.insert(raw.end(), section.begin(), section.end());
+  }
   if (Crc32::Of(raw) != raw_crc) return DataLossError("submap checksum mismatch (payload)");
 
   ByteReader r(raw);
@@ -293,6 +358,8 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   m.options.log_odds_miss = F64(r);
   m.options.log_odds_min = F64(r);
   m.options.log_odds_max = F64(r);
+  m.options.wire_offset_bits = r.U8();
+  m.options.wire_intensity_bits = r.U8();
   if (r.failed()) return DataLossError("submap metadata truncated");
   if (!(m.distance >= 0.0 && std::isfinite(m.distance))) return DataLossError("submap distance is invalid");
   CAIRN_RETURN_IF_ERROR(CheckOptions(m.options));
@@ -304,11 +371,15 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   for (int a = 0; a < 3; ++a) extent[a] = static_cast<int32_t>(r.U32());
   if (r.failed()) return DataLossError("submap cloud header truncated");
   if (color > 1) return DataLossError("submap cloud colour flag is " + std::to_string(color));
-  const uint64_t per_point = color ? 5 : 3;
+  const int offset_bits = static_cast<int>(m.options.wire_offset_bits);
+  const int steps = 1 << offset_bits;
+  const bool packed_offsets = 3 * offset_bits <= 8;
+  const int drop = 8 - static_cast<int>(m.options.wire_intensity_bits);
+  const uint64_t per_point = (color ? 3 : 1) + (packed_offsets ? 1 : 2);
   if (static_cast<uint64_t>(n) * per_point > r.remaining()) return DataLossError("submap cloud count " + std::to_string(n) + " exceeds the data");
   if (n > 0 && (extent.minCoeff() <= 0 || extent.cast<double>().prod() > 1e18)) return DataLossError("submap cloud extent is invalid");
   ByteReader keys(r.Take(r.U32()));
-  const auto xy = r.Take(n), z = r.Take(n);
+  const auto xy = r.Take(n), z = packed_offsets ? xy : r.Take(n);
   const int channels = color ? 3 : 1;
   const auto coded = r.Take(static_cast<uint64_t>(channels) * n);
   const auto bits = r.Take((static_cast<uint64_t>(n) + 7) / 8);
@@ -329,26 +400,40 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
     // in one voxel on the boundary of the next, and both points are kept as they were.
     linear += d;
     if (linear >= cells || linear < d) return DataLossError("submap point " + std::to_string(i) + ": voxel index outside the extent");
-    if ((xy[i] & 0xF) >= kOffsetSteps || z[i] >= kOffsetSteps) return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
+    int o[3];
+    if (packed_offsets) {
+      for (int a = 0; a < 3; ++a) o[a] = (xy[i] >> (a * offset_bits)) & (steps - 1);
+      if ((xy[i] >> (3 * offset_bits)) != 0) return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
+    } else {
+      o[0] = xy[i] & 0xF;
+      o[1] = xy[i] >> 4;
+      o[2] = z[i];
+      if (o[0] >= steps || o[1] >= steps || o[2] >= steps) return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
+    }
     const int64_t x = static_cast<int64_t>(linear % static_cast<uint64_t>(extent.x()));
     const int64_t y = static_cast<int64_t>((linear / static_cast<uint64_t>(extent.x())) % static_cast<uint64_t>(extent.y()));
     const int64_t zz = static_cast<int64_t>(linear / (static_cast<uint64_t>(extent.x()) * static_cast<uint64_t>(extent.y())));
-    const double off[3] = {(xy[i] & 0xF) + 0.5, (xy[i] >> 4) + 0.5, z[i] + 0.5};
+    const double off[3] = {o[0] + 0.5, o[1] + 0.5, o[2] + 0.5};
     const int64_t cell[3] = {x, y, zz};
     int64_t nb[3];
     decoded_keys.push_back(linear);
     predictor.Neighbours(decoded_keys, i, cell, nb);
     for (int c = 0; c < channels; ++c) {
       uint8_t* channel = values.data() + static_cast<size_t>(c) * n;
-      channel[i] = static_cast<uint8_t>(channel[i] + ChannelPredictor::Predict(channel, nb));
+      channel[i] = static_cast<uint8_t>(channel[i] + ChannelPredictor::Predict(channel, nb, 128 >> drop));
+      if ((channel[i] >> (8 - drop)) != 0) {
+        return DataLossError("submap point " + std::to_string(i) + ": intensity or colour out of range");
+      }
     }
     CloudPoint& p = pts[i];
-    p.p = Eigen::Vector3f(static_cast<float>((lo.x() + x + off[0] / kOffsetSteps) * res),
-                          static_cast<float>((lo.y() + y + off[1] / kOffsetSteps) * res),
-                          static_cast<float>((lo.z() + zz + off[2] / kOffsetSteps) * res));
-    p.r = values[i];
-    p.g = values[(color ? n : 0) + i];
-    p.b = values[(color ? 2 * static_cast<size_t>(n) : 0) + i];
+    p.p = Eigen::Vector3f(static_cast<float>((lo.x() + x + off[0] / steps) * res),
+                          static_cast<float>((lo.y() + y + off[1] / steps) * res),
+                          static_cast<float>((lo.z() + zz + off[2] / steps) * res));
+    // Each value comes back at the middle of its quantization step.
+    const auto value = [&](size_t k) { return static_cast<uint8_t>((values[k] << drop) | ((1 << drop) >> 1)); };
+    p.r = value(i);
+    p.g = value((color ? n : 0) + i);
+    p.b = value((color ? 2 * static_cast<size_t>(n) : 0) + i);
     p.obstacle = (bits[i / 8] >> (i % 8)) & 1;
   }
   if (keys.remaining() != 0) return DataLossError("submap voxel index stream has trailing bytes");

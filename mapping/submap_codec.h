@@ -1,16 +1,18 @@
 #pragma once
 // Compact wire format of a finished submap (thesis 5.2.1): metadata, the point cloud quantized to
-// its voxel grid (sorted voxel indices as varint deltas plus a 4-bit centroid offset per axis,
-// i.e. resolution / 16 steps), intensity or colour (version 2: each channel as the difference to
-// the mean of its causal face neighbours, exact), obstacle bits, and the occupancy tree in
-// OctoMap's binary format (maximum-likelihood free/occupied leaves, pruned), all compressed
-// (zstd or LZ4) and protected by CRC-32s of the compressed and the uncompressed bytes. Only the
-// current version decodes (version 1 stored the channels raw).
+// its voxel grid (sorted voxel indices as varint deltas plus a centroid offset of
+// `wire_offset_bits` per axis, i.e. resolution / 2^bits steps), intensity or colour (each channel
+// at `wire_intensity_bits`, as the difference to the mean of its causal face neighbours), obstacle
+// bits, and the occupancy tree in OctoMap's binary format (maximum-likelihood free/occupied leaves,
+// pruned); each stream compressed on its own (zstd or LZ4), all protected by CRC-32s of the
+// compressed and the uncompressed bytes. Only the current version decodes (version 2 had 4 offset
+// bits, 8 intensity bits and one compressed block; version 1 raw channels).
 //
-// Lossy by design: points move by at most resolution / 32 per axis, and the tree keeps only the
-// free/occupied state of each leaf (loaded as the clamping bounds, as OctoMap's .bt does).
-// Intensity, colour and obstacle flags are exact. Two points may share a voxel (a centroid that
-// float rounding put on the boundary of the next voxel); each is kept.
+// Lossy by design: points move by at most resolution / 2^(bits+1) per axis, intensity and colour
+// by half a step (exact at 8 bits); both bit counts travel in the submap's options, so decoding and
+// encoding again changes nothing. The tree keeps only the free/occupied state of each leaf (loaded
+// as the clamping bounds, as OctoMap's .bt does). Obstacle flags are exact. Two points may share a
+// voxel (a centroid that float rounding put on the boundary of the next voxel); each is kept.
 
 #include <cstdint>
 #include <memory>
@@ -26,7 +28,7 @@ namespace cairn {
 
 class SubmapCodec {
  public:
-  static constexpr uint16_t kVersion = 2;
+  static constexpr uint16_t kVersion = 3;
 
   static Expected<std::vector<uint8_t>> Encode(const Submap& submap,
                                                Compression compression = Compression::kZstd);

@@ -11,55 +11,130 @@
 namespace cairn {
 namespace {
 
+// The same submap with other numbers of bits on the wire.
+std::shared_ptr<const Submap> WithWireBits(const Submap& s, int offset_bits, int intensity_bits = 8) {
+  SubmapMetadata m = s.metadata();
+  m.options.wire_offset_bits = offset_bits;
+  m.options.wire_intensity_bits = intensity_bits;
+  return std::make_shared<const Submap>(m, s.points(), std::make_unique<octomap::OcTree>(s.tree()));
+}
+
 TEST(SubmapCodecTest, RoundTripKeepsMetadataQuantizedCloudAndOccupancy) {
-  const auto submap = testing::SyntheticSubmap(7);
-  for (Compression c : {Compression::kZstd, Compression::kLz4}) {
-    auto bytes = SubmapCodec::Encode(*submap, c);
-    ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
-    auto back = SubmapCodec::Decode(*bytes);
-    ASSERT_TRUE(back.ok()) << back.status().ToString();
-    const Submap& s = **back;
-    EXPECT_EQ(s.metadata().robot, "rover1");
-    EXPECT_EQ(s.metadata().id, 7u);
-    EXPECT_EQ(s.metadata().images, 3u);
-    EXPECT_EQ(s.metadata().start, Timestamp::FromSeconds(10.0));
-    EXPECT_EQ(s.metadata().end, Timestamp::FromSeconds(12.0));
-    EXPECT_DOUBLE_EQ(s.metadata().distance, submap->metadata().distance);
-    EXPECT_DOUBLE_EQ(s.metadata().options.octree_resolution, 0.1);
-    // Every point is back in its voxel within resolution / 32 per axis, with its flags.
-    ASSERT_EQ(s.points().size(), submap->points().size());
-    std::map<std::tuple<int, int, int>, CloudPoint> by_voxel;
-    const double res = s.metadata().options.cloud_resolution;
-    const auto voxel = [&](const Eigen::Vector3f& p) {
-      return std::make_tuple(static_cast<int>(std::floor(p.x() / res)), static_cast<int>(std::floor(p.y() / res)),
-                             static_cast<int>(std::floor(p.z() / res)));
-    };
-    for (const CloudPoint& p : s.points()) by_voxel[voxel(p.p)] = p;
-    for (const CloudPoint& p : submap->points()) {
-      auto it = by_voxel.find(voxel(p.p));
-      ASSERT_NE(it, by_voxel.end());
-      EXPECT_LE((it->second.p - p.p).cwiseAbs().maxCoeff(), res / 32 + 1e-5);
-      EXPECT_EQ(it->second.obstacle, p.obstacle);
-      EXPECT_EQ(it->second.r, p.r);
+  const auto original = testing::SyntheticSubmap(7);
+  size_t previous_size = 0;
+  for (const int bits : {1, 2, 3, 4}) {
+    const auto submap = WithWireBits(*original, bits);
+    for (Compression c : {Compression::kZstd, Compression::kLz4}) {
+      SCOPED_TRACE(::testing::Message() << bits << " bits, " << Compressor::Name(c));
+      auto bytes = SubmapCodec::Encode(*submap, c);
+      ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
+      auto back = SubmapCodec::Decode(*bytes);
+      ASSERT_TRUE(back.ok()) << back.status().ToString();
+      const Submap& s = **back;
+      EXPECT_EQ(s.metadata().robot, "rover1");
+      EXPECT_EQ(s.metadata().id, 7u);
+      EXPECT_EQ(s.metadata().images, 3u);
+      EXPECT_EQ(s.metadata().start, Timestamp::FromSeconds(10.0));
+      EXPECT_EQ(s.metadata().end, Timestamp::FromSeconds(12.0));
+      EXPECT_DOUBLE_EQ(s.metadata().distance, submap->metadata().distance);
+      EXPECT_DOUBLE_EQ(s.metadata().options.octree_resolution, 0.1);
+      EXPECT_EQ(s.metadata().options.wire_offset_bits, bits);
+      // Every point is back in its voxel within resolution / 2^(bits+1) per axis, with its flags.
+      ASSERT_EQ(s.points().size(), submap->points().size());
+      std::map<std::tuple<int, int, int>, CloudPoint> by_voxel;
+      const double res = s.metadata().options.cloud_resolution;
+      const auto voxel = [&](const Eigen::Vector3f& p) {
+        return std::make_tuple(static_cast<int>(std::floor(p.x() / res)), static_cast<int>(std::floor(p.y() / res)),
+                               static_cast<int>(std::floor(p.z() / res)));
+      };
+      for (const CloudPoint& p : s.points()) by_voxel[voxel(p.p)] = p;
+      for (const CloudPoint& p : submap->points()) {
+        auto it = by_voxel.find(voxel(p.p));
+        ASSERT_NE(it, by_voxel.end());
+        EXPECT_LE((it->second.p - p.p).cwiseAbs().maxCoeff(), res / (2 << bits) + 1e-5);
+        EXPECT_EQ(it->second.obstacle, p.obstacle);
+        EXPECT_EQ(it->second.r, p.r);
+      }
+      // Same free/occupied state for every leaf of the original.
+      int64_t leaves = 0;
+      for (auto it = submap->tree().begin_leafs(); it != submap->tree().end_leafs(); ++it) {
+        const octomap::OcTreeNode* n = s.tree().search(it.getKey());
+        ASSERT_NE(n, nullptr);
+        EXPECT_EQ(s.tree().isNodeOccupied(n), submap->tree().isNodeOccupied(*it));
+        ++leaves;
+      }
+      EXPECT_GT(leaves, 100);
+      // Decoded and encoded again, the submap is the same bytes: a relay changes nothing.
+      auto again = SubmapCodec::Encode(s, c);
+      ASSERT_TRUE(again.ok());
+      EXPECT_EQ(*again, *bytes);
+      if (c == Compression::kZstd) {
+        // Fewer bits, fewer bytes.
+        if (previous_size > 0) {
+          EXPECT_GT(bytes->size(), previous_size);
+        }
+        previous_size = bytes->size();
+      }
     }
-    // Same free/occupied state for every leaf of the original.
-    int64_t leaves = 0;
-    for (auto it = submap->tree().begin_leafs(); it != submap->tree().end_leafs(); ++it) {
-      const octomap::OcTreeNode* n = s.tree().search(it.getKey());
-      ASSERT_NE(n, nullptr);
-      EXPECT_EQ(s.tree().isNodeOccupied(n), submap->tree().isNodeOccupied(*it));
-      ++leaves;
-    }
-    EXPECT_GT(leaves, 100);
   }
 }
 
-// Version 2 codes colour as residuals of a neighbour prediction: still exact. Two points in one
-// voxel (a centroid rounded onto the next voxel's boundary) both come back.
+// Intensity quantized to fewer bits comes back within half a step, and takes fewer bytes.
+TEST(SubmapCodecTest, IntensityBitsTradeBytesForSteps) {
+  const auto original = testing::SyntheticSubmap(7);
+  size_t previous_size = 0;
+  for (const int bits : {8, 6, 3, 1}) {
+    SCOPED_TRACE(::testing::Message() << bits << " intensity bits");
+    auto bytes = SubmapCodec::Encode(*WithWireBits(*original, 2, bits));
+    ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
+    auto back = SubmapCodec::Decode(*bytes);
+    ASSERT_TRUE(back.ok()) << back.status().ToString();
+    EXPECT_EQ((*back)->metadata().options.wire_intensity_bits, bits);
+    // Points come back in voxel order: compare the sorted intensities.
+    std::vector<int> a, b;
+    for (const CloudPoint& p : original->points()) a.push_back(p.r);
+    for (const CloudPoint& p : (*back)->points()) b.push_back(p.r);
+    ASSERT_EQ(a.size(), b.size());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    const int half_step = (1 << (8 - bits)) / 2;
+    int worst = 0;
+    for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+    EXPECT_LE(worst, half_step);
+    if (bits < 8) {
+      EXPECT_GT(worst, 0);
+    }
+    if (previous_size > 0) {
+      EXPECT_LT(bytes->size(), previous_size);
+    }
+    previous_size = bytes->size();
+    auto again = SubmapCodec::Encode(**back);
+    ASSERT_TRUE(again.ok());
+    EXPECT_EQ(*again, *bytes);
+  }
+  for (const int bits : {0, 9}) {
+    auto bytes = SubmapCodec::Encode(*WithWireBits(*original, 2, bits));
+    ASSERT_FALSE(bytes.ok());
+    EXPECT_NE(bytes.status().message().find("wire_intensity_bits"), std::string::npos) << bytes.status().ToString();
+  }
+}
+
+TEST(SubmapCodecTest, RefusesOffsetBitsOutsideTheirRange) {
+  const auto submap = testing::SyntheticSubmap(7, 1);
+  for (const int bits : {0, 5}) {
+    auto bytes = SubmapCodec::Encode(*WithWireBits(*submap, bits));
+    ASSERT_FALSE(bytes.ok());
+    EXPECT_NE(bytes.status().message().find("wire_offset_bits"), std::string::npos) << bytes.status().ToString();
+  }
+}
+
+// Colour as residuals of a neighbour prediction, at 8 bits: exact. Two points in one voxel (a
+// centroid rounded onto the next voxel's boundary) both come back.
 TEST(SubmapCodecTest, ColourAndSharedVoxelsRoundTripExactly) {
   SubmapMetadata m;
   m.robot = "hexacopter";
   m.id = 2;
+  m.options.wire_intensity_bits = 8;
   std::vector<CloudPoint> pts;
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> u8(0, 255);
@@ -101,7 +176,7 @@ TEST(SubmapCodecTest, ColourAndSharedVoxelsRoundTripExactly) {
         best = j;
       }
     }
-    ASSERT_LE(best_d, res / 32 + 1e-5f);
+    ASSERT_LE(best_d, res / 8 + 1e-5f);  // 2 offset bits per axis
     const CloudPoint& q = (*back)->points()[best];
     used[best] = true;
     EXPECT_EQ(q.g, p.g);
@@ -135,8 +210,8 @@ TEST(SubmapCodecTest, RejectsCorruptInputWithAClearError) {
   bad = good;
   bad[8] = 9;  // version
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version"), std::string::npos);
-  bad[8] = 1;  // the previous format (raw channels) is not read as this one
-  EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version 1 is not supported"), std::string::npos);
+  bad[8] = 2;  // the previous format (4 offset bits always) is not read as this one
+  EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version 2 is not supported"), std::string::npos);
   bad = good;
   bad.back() ^= 1;
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("checksum"), std::string::npos);

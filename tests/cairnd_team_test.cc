@@ -343,6 +343,19 @@ TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
     ASSERT_EQ(views.back().robots.size(), 2u) << m->name;
   }
   ExpectAgreement(views, 100);
+  // `cairn summary` puts each robot's bytes sent over its links per second of the mission.
+  const ProcessResult summary = RunProcess({Cairn(), "summary", dir + "/rover", dir + "/hexacopter"});
+  ASSERT_EQ(summary.exit_code, 0) << summary.output;
+  for (const Member* m : members) {
+    const JsonValue t = JsonValue::ParseFile(dir + "/" + m->name + "/team.json");
+    double sent = 0.0;
+    for (const JsonValue& peer : t["peers"].array()) sent += peer["sent_bytes"].number();
+    const double seconds = JsonValue::ParseFile(dir + "/" + m->name + "/summary.json")["streams"]["imu"]["duration_s"].number();
+    char line[160];
+    std::snprintf(line, sizeof(line), "sent per second of the 8 s mission: %.2f KB/s per link (mean over 1), %.2f KB/s over all links",
+                  sent / 1e3 / seconds, sent / 1e3 / seconds);
+    EXPECT_NE(summary.output.find(line), std::string::npos) << line << "\n" << summary.output;
+  }
 }
 
 // The team's faults all in one run: 30 % of the packets lost at random, a 2 s one-way delay on

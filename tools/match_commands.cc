@@ -96,7 +96,8 @@ Status ReadIndexedSubmaps(const std::string& dir, std::vector<IndexedSubmap>* ou
     char name[32];
     std::snprintf(name, sizeof(name), "-%06llu.submap", static_cast<unsigned long long>(s.id));
     auto submap = SubmapCodec::ReadFile(dir + "/submaps/" + s.robot + name);
-    if (!submap.ok()) continue;  // listed but never finished (e.g. empty)
+    if (!submap.ok() && submap.status().code() == StatusCode::kNotFound) continue;  // listed, never finished
+    if (!submap.ok()) return submap.status();
     s.submap = *submap;
     out->push_back(std::move(s));
   }
@@ -141,16 +142,22 @@ double Median(std::vector<double> v) {
 int RunBenchMatch(const CommandArgs& args) {
   std::vector<std::string> dirs;
   double min_overlap = 0.3;
+  std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     std::vector<double> v;
     if (a == "--min-overlap" && i + 1 < args.args.size() && ParseList(args.args[i + 1], 1, &v)) {
       min_overlap = v[0];
       ++i;
+    } else if (a == "--wire-bits" && i + 1 < args.args.size() && ParseList(args.args[i + 1], 2, &v)) {
+      wire_bits = v;
+      ++i;
     } else if (a.empty() || a[0] == '-') {
       std::fprintf(stderr,
-                   "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)]\n"
-                   "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n");
+                   "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
+                   "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
+                   "  --wire-bits: first send every submap through the wire format at these bit counts\n"
+                   "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n");
       return 2;
     } else {
       dirs.push_back(a);
@@ -167,6 +174,22 @@ int RunBenchMatch(const CommandArgs& args) {
       return 1;
     }
   }
+  if (!wire_bits.empty()) {
+    for (IndexedSubmap& s : submaps) {
+      SubmapMetadata m = s.submap->metadata();
+      m.options.wire_offset_bits = static_cast<int64_t>(wire_bits[0]);
+      m.options.wire_intensity_bits = static_cast<int64_t>(wire_bits[1]);
+      const Submap coarse(m, s.submap->points(), std::make_unique<octomap::OcTree>(s.submap->tree()));
+      auto bytes = SubmapCodec::Encode(coarse);
+      auto back = bytes.ok() ? SubmapCodec::Decode(*bytes) : Expected<std::shared_ptr<const Submap>>(bytes.status());
+      if (!back.ok()) {
+        std::fprintf(stderr, "cairn bench match: %s/%llu: %s\n", s.robot.c_str(), static_cast<unsigned long long>(s.id),
+                     back.status().ToString().c_str());
+        return 1;
+      }
+      s.submap = *back;
+    }
+  }
   const SubmapFeatureExtractor extractor;
   std::vector<double> feature_ms;
   size_t suitable = 0;
@@ -180,7 +203,7 @@ int RunBenchMatch(const CommandArgs& args) {
   std::printf("  keypoints + descriptors per submap: median %.1f ms, max %.1f ms\n", Median(feature_ms),
               feature_ms.empty() ? NAN : *std::max_element(feature_ms.begin(), feature_ms.end()));
   const SubmapMatcher matcher;
-  std::vector<double> match_ms;
+  std::vector<double> match_ms, good_error_m, good_error_deg;
   size_t positives = 0, found = 0, matched = 0, correct = 0, negatives = 0, false_matches = 0;
   for (size_t i = 0; i < submaps.size(); ++i) {
     for (size_t j = i + 1; j < submaps.size(); ++j) {
@@ -197,6 +220,10 @@ int RunBenchMatch(const CommandArgs& args) {
       const bool good = r.matched() && error.translation().norm() <= 0.05 && std::abs(error.yaw()) <= 0.5 * M_PI / 180;
       matched += r.matched();
       correct += good;
+      if (good) {
+        good_error_m.push_back(error.translation().norm());
+        good_error_deg.push_back(std::abs(error.yaw()) * 180 / M_PI);
+      }
       if (overlap >= min_overlap) {
         ++positives;
         found += good;
@@ -221,6 +248,10 @@ int RunBenchMatch(const CommandArgs& args) {
               positives, 100.0 * min_overlap);
   std::printf("  precision: %zu of %zu matches within 5 cm and 0.5 deg; %zu of %zu pairs without overlap matched\n",
               correct, matched, false_matches, negatives);
+  std::printf("  error of those within: median %.4f m %.3f deg, max %.4f m %.3f deg\n", Median(good_error_m),
+              Median(good_error_deg),
+              good_error_m.empty() ? NAN : *std::max_element(good_error_m.begin(), good_error_m.end()),
+              good_error_deg.empty() ? NAN : *std::max_element(good_error_deg.begin(), good_error_deg.end()));
   return 0;
 }
 

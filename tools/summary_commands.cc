@@ -69,6 +69,19 @@ void PrintMapAccuracy(const std::string& dir, const Eigen::Isometry3d& T_world_m
   }
 }
 
+// The longest stream of summary.json (the mission's data), or 0 when there is none.
+double MissionSeconds(const std::string& dir) {
+  const std::string path = dir + "/summary.json";
+  if (!std::filesystem::exists(path)) return 0.0;
+  const JsonValue s = JsonValue::ParseFile(path);
+  double longest = 0.0;
+  if (!s.has("streams") || s["streams"].type() != JsonValue::Type::kObject) return 0.0;
+  for (const auto& [name, stream] : s["streams"].object()) {
+    if (stream.has("duration_s")) longest = std::max(longest, stream["duration_s"].number());
+  }
+  return longest;
+}
+
 // team.json: the exchange per peer, and every robot's global trajectory as this robot's graph places
 // it, scored with one alignment for the team against the ground truth in each robot's sibling
 // output folder (the demo's out/<robot>/).
@@ -78,6 +91,7 @@ void PrintTeam(const std::string& dir) {
   const JsonValue t = JsonValue::ParseFile(path);
   std::printf("  team: %s, exchange %.0f s%s\n", t["settled"].boolean() ? "settled" : "NOT settled",
               t["seconds"].number(), t["settled"].boolean() ? " (every teammate holds the same logs)" : "");
+  double sent = 0.0;
   for (const JsonValue& p : t["peers"].array()) {
     std::printf("    link to %s: sent %.1f KB (%.2f KB/s), received %.1f KB (%.2f KB/s), items %.0f out / %.0f in, "
                 "%.0f duplicates, %.0f resends, %.0f queued\n",
@@ -85,6 +99,15 @@ void PrintTeam(const std::string& dir) {
                 p["received_bytes"].number() / 1e3, p["received_bytes_per_s"].number() / 1e3,
                 p["items_sent"].number(), p["items_received"].number(), p["duplicates"].number(),
                 p["resends"].number(), p["queued_items"].number());
+    sent += p["sent_bytes"].number();
+  }
+  // Per second of the mission rather than of the exchange, which runs faster or slower than the
+  // mission in a replay and lingers after it.
+  const double mission_s = MissionSeconds(dir);
+  if (mission_s > 0.0 && !t["peers"].array().empty()) {
+    std::printf("    sent per second of the %.0f s mission: %.2f KB/s per link (mean over %zu), %.2f KB/s over all links\n",
+                mission_s, sent / 1e3 / mission_s / static_cast<double>(t["peers"].array().size()),
+                t["peers"].array().size(), sent / 1e3 / mission_s);
   }
   std::vector<TeamTrajectory> team;
   std::string not_connected;
