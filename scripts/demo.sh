@@ -15,6 +15,7 @@ world="${CAIRN_DEMO_WORLD:-}"  # a world file; "" = the profiles' default world
 seed="${CAIRN_DEMO_SEED:-1}"
 port="${CAIRN_DEMO_PORT:-47701}"
 out="${CAIRN_DEMO_OUT:-out}"
+read -r -a extra <<<"${CAIRN_DEMO_SET:-}"  # more KEY=VALUE settings for every robot, space separated
 cairnd=./build/release/daemon/cairnd
 cairn=./build/release/tools/cairn
 robots=(rover hexacopter rover2)
@@ -35,6 +36,7 @@ common=(--sim --set "sim.duration=$duration" --set "sim.seed=$seed" ${world:+--s
         --set sim.deploy_from_lander=true --set replay.pacing=fast --set replay.deterministic=true --set live.enabled=false
         --set recording.enabled=false --set team.enabled=true --set "team.members_file=$team/team.yaml"
         --set team.linger=600 --log-level warn)
+for kv in "${extra[@]}"; do common+=(--set "$kv"); done
 echo "demo: simulating a ${duration} s mission of ${robots[*]} on ${world:-the default world} (seed $seed), exchanging over loopback"
 pids=()
 for i in "${!robots[@]}"; do
