@@ -87,6 +87,7 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
         n.rfind("rover", 0) == 0
             ? MakeRover(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment)
             : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment));
+    if (n.rfind("rover", 0) == 0 && world.roof_tag_size > 0.0) AddRoofTag(index, world.roof_tag_size, &sim->robots_.back());
   }
   if (world.lander.size() == 2) {
     // A lander: a 1.6 m box on the ground with a tag on each side.

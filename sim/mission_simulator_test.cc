@@ -36,6 +36,24 @@ MissionOptions ShortMission() {
   return m;
 }
 
+// Ids of the tags libapriltag finds in a rendered image, at full resolution.
+std::vector<int> DetectedTagIds(const std::vector<uint8_t>& pixels, const PinholeRadTan& k) {
+  Image image;
+  image.data = std::shared_ptr<const uint8_t[]>(pixels.data(), [](const uint8_t*) {});
+  image.width = k.width;
+  image.height = k.height;
+  image.stride = k.width;
+  TagDetectorOptions o;
+  o.decimate = 1.0;
+  const auto found = TagDetector(o).Detect(image);
+  EXPECT_TRUE(found.ok());
+  std::vector<int> ids;
+  if (found.ok()) {
+    for (const TagDetection& d : *found) ids.push_back(d.id);
+  }
+  return ids;
+}
+
 // FNV-1a over every file's relative path and bytes, in sorted order.
 uint64_t TreeHash(const std::string& root) {
   std::vector<std::string> files;
@@ -125,7 +143,7 @@ TEST(MissionSimulatorTest, RobotsSeeEachOther) {
   auto sim = MissionSimulator::Create(SmallWorld(3), m);
   ASSERT_TRUE(sim.ok());
   const RenderScene scene = (*sim)->SceneAt(0.5);
-  EXPECT_EQ(scene.markers.size(), 3u + 1u + 4u);  // rover tags, hexacopter tag, lander tags
+  EXPECT_EQ(scene.markers.size(), 3u + 1u + 1u + 4u);  // rover tags and roof tag, hexacopter tag, lander tags
   EXPECT_EQ(scene.boxes.size(), 2u + 1u + 1u);
 }
 
@@ -156,19 +174,8 @@ TEST(MissionSimulatorTest, DeployedRobotsStartInFrontOfALanderTagAndSeeIt) {
     }
     std::vector<uint8_t> left, right;
     (*sim)->RenderStereo(r, 1.0, 10, &left, &right);
-    const PinholeRadTan& k = robot.stereo.left.intrinsics;
-    Image image;
-    image.data = std::shared_ptr<const uint8_t[]>(left.data(), [](const uint8_t*) {});
-    image.width = k.width;
-    image.height = k.height;
-    image.stride = k.width;
-    TagDetectorOptions o;
-    o.decimate = 1.0;
-    TagDetector detector(o);
-    const auto found = detector.Detect(image);
-    ASSERT_TRUE(found.ok());
     bool lander_tag = false;
-    for (const TagDetection& d : *found) lander_tag = lander_tag || (d.id >= 200 && d.id <= 203);
+    for (const int id : DetectedTagIds(left, robot.stereo.left.intrinsics)) lander_tag = lander_tag || (id >= 200 && id <= 203);
     EXPECT_TRUE(lander_tag) << robot.name << " does not see a lander tag";
     EXPECT_GT(robot.trajectory.Evaluate(35.0).velocity.norm(), 0.2) << robot.name << " never set out";
   }
@@ -179,6 +186,46 @@ TEST(MissionSimulatorTest, DeployedRobotsStartInFrontOfALanderTagAndSeeIt) {
   world.lander.clear();
   m.robots = {"rover"};
   EXPECT_FALSE(MissionSimulator::Create(world, m).ok());
+}
+
+// A rover's roof tag faces up from its rear deck: the hexacopter's camera finds it from 4 m above
+// and behind, while the rover's own camera, ahead of it on the mast, does not see it.
+TEST(MissionSimulatorTest, ARoofTagIsSeenFromAboveAndNotByItsRover) {
+  MissionOptions m = ShortMission();
+  m.image_scale = 1.0;
+  auto sim = MissionSimulator::Create(SmallWorld(3), m);
+  ASSERT_TRUE(sim.ok());
+  const SimRobot& rover = (*sim)->robots()[0];
+  const SimRobot& hexacopter = (*sim)->robots()[1];
+  const SimMarker* roof = nullptr;
+  for (const SimMarker& marker : rover.markers) {
+    if (marker.id == 3) roof = &marker;
+  }
+  ASSERT_NE(roof, nullptr);
+  EXPECT_DOUBLE_EQ(roof->size, WorldOptions{}.roof_tag_size);
+  EXPECT_GT((roof->T_body_marker.linear() * Eigen::Vector3d::UnitZ()).z(), 0.999);  // faces up
+  const Eigen::Isometry3d T_world_rover = rover.trajectory.Evaluate(0.0).T_world_body;
+  RenderScene scene = (*sim)->SceneAt(0.0);
+  // The hexacopter's left camera 4 m above the deck and 2 m behind the rover, looking along it.
+  const CameraCalibration& cam = hexacopter.stereo.left;
+  Eigen::Isometry3d T_world_hexacopter = T_world_rover;
+  T_world_hexacopter.translation() += T_world_rover.linear() * Eigen::Vector3d(-2.2, 0.0, 4.0);
+  std::vector<uint8_t> above;
+  CameraRenderer::Render(scene, cam.intrinsics, T_world_hexacopter * cam.T_body_cam, m.render, 1, &above, nullptr);
+  const std::vector<int> seen = DetectedTagIds(above, cam.intrinsics);
+  EXPECT_NE(std::find(seen.begin(), seen.end(), 3), seen.end()) << "the hexacopter does not find the roof tag";
+  // The rover's own left camera.
+  std::vector<uint8_t> own;
+  const CameraCalibration& rover_cam = rover.stereo.left;
+  CameraRenderer::Render(scene, rover_cam.intrinsics, T_world_rover * rover_cam.T_body_cam, m.render, 2, &own, nullptr);
+  const std::vector<int> own_seen = DetectedTagIds(own, rover_cam.intrinsics);
+  EXPECT_EQ(std::find(own_seen.begin(), own_seen.end(), 3), own_seen.end()) << "the rover sees its own roof tag";
+  // Without the key's tag (0), rovers carry none.
+  WorldOptions bare = SmallWorld(3);
+  bare.roof_tag_size = 0.0;
+  auto without = MissionSimulator::Create(bare, m);
+  ASSERT_TRUE(without.ok());
+  for (const SimMarker& marker : (*without)->robots()[0].markers) EXPECT_NE(marker.id, 3);
 }
 
 // Motion blur averages the exposure: the image changes and loses high-frequency energy.

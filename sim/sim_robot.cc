@@ -218,6 +218,16 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
   return r;
 }
 
+void AddRoofTag(int index, double size, SimRobot* rover) {
+  SimMarker m;
+  m.id = 10 * index + 3;
+  m.size = size;
+  m.bits = *Tag36h11MarkerBits(m.id);
+  // Behind the mast, so that the rover's own camera does not see it; 1 mm above the deck.
+  m.T_body_marker.translation() = Eigen::Vector3d(-0.2, 0.0, 0.151);
+  rover->markers.push_back(m);
+}
+
 SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
                         double duration, double image_scale, double tag_size, Deployment* deployment) {
   SimRobot r;

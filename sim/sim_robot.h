@@ -60,6 +60,9 @@ struct Deployment {
 // `image_scale` shrinks the cameras (tests); `index` separates robots of one mission.
 SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
                    double duration, double image_scale, double tag_size, Deployment* deployment = nullptr);
+// A tag lying flat on a rover's rear deck, facing up (id 10 * index + 3): what a multicopter above
+// sees of it. The deck is 0.9 m x 0.7 m, so `size` (the tag's black square) is at most 0.4 m.
+void AddRoofTag(int index, double size, SimRobot* rover);
 // Ardea-like hexacopter: stereo pair (666 x 506, b = 0.12 m) pitched 60 deg down, 400 Hz IMU.
 SimRobot MakeHexacopter(const Terrain& terrain, const std::string& name, int index, uint64_t seed,
                         double duration, double image_scale, double tag_size, Deployment* deployment = nullptr);

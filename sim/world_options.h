@@ -28,6 +28,9 @@ struct WorldOptions {
   // into the terrain over another half of it; 0 leaves the terrain as it is.
   double landing_site = 5.0;
   double tag_size = 0.16;         // edge of the tags' black border square
+  // A rover's tag on its deck facing up, for the multicopter above (larger: it is seen from 3-5 m);
+  // 0: none.
+  double roof_tag_size = 0.4;
 
   void Visit(OptionsVisitor& v) {
     v.Number("size", size, 10.0, 400.0, "m");
@@ -44,6 +47,7 @@ struct WorldOptions {
     v.Numbers("lander", lander, 0, 2, -200.0, 200.0, "m");
     v.Number("landing_site", landing_site, 0.0, 50.0, "m");
     v.Number("tag_size", tag_size, 0.02, 2.0, "m");
+    v.Number("roof_tag_size", roof_tag_size, 0.0, 0.4, "m");
   }
   Status Validate() const {
     if (size / resolution > 8000.0) {
