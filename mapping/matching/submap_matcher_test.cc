@@ -151,7 +151,7 @@ TEST(SubmapMatcherSceneTest, SubmapsFromTheWireMatchAsPreciselyAsTheOriginals) {
   const SubmapFeatureExtractor extractor;
   const SubmapMatcher matcher;
   double sum2[2] = {0.0, 0.0};
-  const int kPairs = 5;
+  const int kPairs = 3;
   for (int seed = 1; seed <= kPairs; ++seed) {
     const testing::ScenePair pair = testing::OverlappingSubmaps(static_cast<unsigned>(seed));
     const Truth truth = TruthOf(pair);
