@@ -93,17 +93,23 @@ class ChannelPredictor {
   size_t next_[3] = {0, 0, 0};
 };
 
+// The bit counts of the wire, named as their configuration keys; empty when both are in range.
+std::string WireBitsProblem(const SubmapOptions& o) {
+  if (o.wire_offset_bits < 1 || o.wire_offset_bits > 4) {
+    return "wire_offset_bits " + std::to_string(o.wire_offset_bits) + " outside 1..4";
+  }
+  if (o.wire_intensity_bits < 1 || o.wire_intensity_bits > 8) {
+    return "wire_intensity_bits " + std::to_string(o.wire_intensity_bits) + " outside 1..8";
+  }
+  return "";
+}
+
 Status CheckOptions(const SubmapOptions& o) {
   const auto bad = [](double v, double lo, double hi) { return !(v >= lo && v <= hi); };
   if (bad(o.cloud_resolution, 0.001, 10.0) || bad(o.octree_resolution, 0.001, 10.0)) {
     return DataLossError("submap resolutions out of range");
   }
-  if (o.wire_offset_bits < 1 || o.wire_offset_bits > 4) {
-    return DataLossError("submap offset bits " + std::to_string(o.wire_offset_bits) + " outside 1..4");
-  }
-  if (o.wire_intensity_bits < 1 || o.wire_intensity_bits > 8) {
-    return DataLossError("submap intensity bits " + std::to_string(o.wire_intensity_bits) + " outside 1..8");
-  }
+  if (const std::string problem = WireBitsProblem(o); !problem.empty()) return DataLossError("submap " + problem);
   if (bad(o.log_odds_hit, 0.0, 100.0) || bad(o.log_odds_miss, -100.0, 0.0) ||
       bad(o.log_odds_min, -100.0, 0.0) || bad(o.log_odds_max, 0.0, 100.0)) {
     return DataLossError("submap log-odds parameters out of range");
@@ -142,6 +148,9 @@ Status SubmapCodec::ValidateOctreeBinary(std::span<const uint8_t> data) {
 Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compression compression) {
   const SubmapMetadata& m = submap.metadata();
   if (m.robot.size() > 255) return InvalidArgumentError("submap robot name longer than 255 bytes");
+  if (const std::string problem = WireBitsProblem(m.options); !problem.empty()) {
+    return InvalidArgumentError("submap " + problem);
+  }
   ByteWriter w;
   w.U8(static_cast<uint8_t>(m.robot.size()));
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(m.robot.data()), m.robot.size()));
@@ -163,15 +172,8 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   const std::vector<CloudPoint>& pts = submap.points();
   const double res = m.options.cloud_resolution;
   const int offset_bits = static_cast<int>(m.options.wire_offset_bits);
-  if (offset_bits < 1 || offset_bits > 4) {
-    return InvalidArgumentError("submap wire_offset_bits " + std::to_string(offset_bits) + " outside 1..4");
-  }
   const int steps = 1 << offset_bits;
-  const int intensity_bits = static_cast<int>(m.options.wire_intensity_bits);
-  if (intensity_bits < 1 || intensity_bits > 8) {
-    return InvalidArgumentError("submap wire_intensity_bits " + std::to_string(intensity_bits) + " outside 1..8");
-  }
-  const int drop = 8 - intensity_bits;
+  const int drop = 8 - static_cast<int>(m.options.wire_intensity_bits);
   struct Q {
     uint64_t linear;
     int64_t d[3];  // cell in the extent

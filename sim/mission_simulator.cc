@@ -83,11 +83,11 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
   for (size_t i = 0; i < mission.robots.size(); ++i) {
     const std::string& n = mission.robots[i];
     const int index = static_cast<int>(i);
+    const bool rover = n.rfind("rover", 0) == 0;
     sim->robots_.push_back(
-        n.rfind("rover", 0) == 0
-            ? MakeRover(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment)
-            : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment));
-    if (n.rfind("rover", 0) == 0 && world.roof_tag_size > 0.0) AddRoofTag(index, world.roof_tag_size, &sim->robots_.back());
+        rover ? MakeRover(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment)
+              : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment));
+    if (rover && world.roof_tag_size > 0.0) AddRoofTag(index, world.roof_tag_size, &sim->robots_.back());
   }
   if (world.lander.size() == 2) {
     // A lander: a 1.6 m box on the ground with a tag on each side.

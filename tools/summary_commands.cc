@@ -69,14 +69,10 @@ void PrintMapAccuracy(const std::string& dir, const Eigen::Isometry3d& T_world_m
   }
 }
 
-// The longest stream of summary.json (the mission's data), or 0 when there is none.
-double MissionSeconds(const std::string& dir) {
-  const std::string path = dir + "/summary.json";
-  if (!std::filesystem::exists(path)) return 0.0;
-  const JsonValue s = JsonValue::ParseFile(path);
+// The longest of summary.json's streams (the mission's data), or 0 when there is none.
+double MissionSeconds(const JsonValue& streams) {
   double longest = 0.0;
-  if (!s.has("streams") || s["streams"].type() != JsonValue::Type::kObject) return 0.0;
-  for (const auto& [name, stream] : s["streams"].object()) {
+  for (const auto& [name, stream] : streams.object()) {
     if (stream.has("duration_s")) longest = std::max(longest, stream["duration_s"].number());
   }
   return longest;
@@ -84,8 +80,8 @@ double MissionSeconds(const std::string& dir) {
 
 // team.json: the exchange per peer, and every robot's global trajectory as this robot's graph places
 // it, scored with one alignment for the team against the ground truth in each robot's sibling
-// output folder (the demo's out/<robot>/).
-void PrintTeam(const std::string& dir) {
+// output folder (the demo's out/<robot>/). Bytes sent are also given per second of the mission.
+void PrintTeam(const std::string& dir, double mission_s) {
   const std::string path = dir + "/team.json";
   if (!std::filesystem::exists(path)) return;
   const JsonValue t = JsonValue::ParseFile(path);
@@ -103,7 +99,6 @@ void PrintTeam(const std::string& dir) {
   }
   // Per second of the mission rather than of the exchange, which runs faster or slower than the
   // mission in a replay and lingers after it.
-  const double mission_s = MissionSeconds(dir);
   if (mission_s > 0.0 && !t["peers"].array().empty()) {
     std::printf("    sent per second of the %.0f s mission: %.2f KB/s per link (mean over %zu), %.2f KB/s over all links\n",
                 mission_s, sent / 1e3 / mission_s / static_cast<double>(t["peers"].array().size()),
@@ -245,7 +240,7 @@ int RunSummary(const CommandArgs& args) {
       if (std::filesystem::exists(std::string(dir) + "/global_trajectory.tum"))
         PrintAccuracy(dir, "global_trajectory.tum", "global (graph) vs ground truth");
       if (T_world_est && s["mode"].string() == "sim") PrintMapAccuracy(dir, *T_world_est);
-      PrintTeam(dir);
+      PrintTeam(dir, MissionSeconds(streams));
       if (auto view = ReadTeamView(dir)) views.push_back(std::move(*view));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "cairn summary: %s: %s\n", path.c_str(), e.what());
