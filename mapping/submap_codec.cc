@@ -109,7 +109,8 @@ Status CheckOptions(const SubmapOptions& o) {
   if (bad(o.cloud_resolution, 0.001, 10.0) || bad(o.octree_resolution, 0.001, 10.0)) {
     return DataLossError("submap resolutions out of range");
   }
-  if (const std::string problem = WireBitsProblem(o); !problem.empty()) return DataLossError("submap " + problem);
+  if (const std::string problem = WireBitsProblem(o); !problem.empty())
+    return DataLossError("submap " + problem);
   if (bad(o.log_odds_hit, 0.0, 100.0) || bad(o.log_odds_miss, -100.0, 0.0) ||
       bad(o.log_odds_min, -100.0, 0.0) || bad(o.log_odds_max, 0.0, 100.0)) {
     return DataLossError("submap log-odds parameters out of range");
@@ -225,7 +226,8 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   // Separate streams per field compress far better than interleaved records; up to 2 bits per
   // axis one byte holds all three offsets.
   if (3 * offset_bits <= 8) {
-    for (const Q& e : q) w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << offset_bits) | (e.off[2] << (2 * offset_bits))));
+    for (const Q& e : q)
+      w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << offset_bits) | (e.off[2] << (2 * offset_bits))));
   } else {
     for (const Q& e : q) w.U8(static_cast<uint8_t>(e.off[0] | (e.off[1] << 4)));
     cuts.push_back(w.size());
@@ -250,7 +252,8 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
     predictor.Neighbours(keys, i, q[i].d, nb);
     for (int c = 0; c < channels; ++c) {
       const uint8_t* channel = values.data() + c * q.size();
-      residuals[c * q.size() + i] = static_cast<uint8_t>(channel[i] - ChannelPredictor::Predict(channel, nb, 128 >> drop));
+      residuals[c * q.size() + i] =
+          static_cast<uint8_t>(channel[i] - ChannelPredictor::Predict(channel, nb, 128 >> drop));
     }
   }
   w.Bytes(residuals);
@@ -266,7 +269,8 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(tree.data()), tree.size()));
 
   cuts.push_back(w.size());
-  if (w.size() > kMaxPayload) return InvalidArgumentError("submap larger than " + std::to_string(kMaxPayload) + " bytes");
+  if (w.size() > kMaxPayload)
+    return InvalidArgumentError("submap larger than " + std::to_string(kMaxPayload) + " bytes");
   // Body: section count, (raw size, packed size) per section, then the packed sections.
   ByteWriter body;
   body.U8(static_cast<uint8_t>(cuts.size() - 1));
@@ -322,7 +326,8 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   ByteReader sections(packed);
   const uint8_t count = sections.U8();
   if (sections.failed() || count == 0 || count > kMaxSections) {
-    return DataLossError("submap body has " + std::to_string(count) + " sections (1.." + std::to_string(kMaxSections) + ")");
+    return DataLossError("submap body has " + std::to_string(count) + " sections (1.." +
+                         std::to_string(kMaxSections) + ")");
   }
   std::vector<std::pair<uint32_t, uint32_t>> table(count);
   uint64_t raw_total = 0, packed_total = 0;
@@ -338,9 +343,10 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   std::vector<uint8_t> raw, section;
   raw.reserve(raw_size);
   for (size_t i = 0; i < table.size(); ++i) {
-    const Status st = Compressor::Decompress(static_cast<Compression>(compression), sections.Take(table[i].second),
-                                             table[i].first, &section);
-    if (!st.ok()) return DataLossError("submap section " + std::to_string(i) + " does not decompress: " + st.message());
+    const Status st = Compressor::Decompress(static_cast<Compression>(compression),
+                                             sections.Take(table[i].second), table[i].first, &section);
+    if (!st.ok())
+      return DataLossError("submap section " + std::to_string(i) + " does not decompress: " + st.message());
     raw.insert(raw.end(), section.begin(), section.end());
   }
   if (Crc32::Of(raw) != raw_crc) return DataLossError("submap checksum mismatch (payload)");
@@ -405,12 +411,14 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
     int o[3];
     if (packed_offsets) {
       for (int a = 0; a < 3; ++a) o[a] = (xy[i] >> (a * offset_bits)) & (steps - 1);
-      if ((xy[i] >> (3 * offset_bits)) != 0) return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
+      if ((xy[i] >> (3 * offset_bits)) != 0)
+        return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
     } else {
       o[0] = xy[i] & 0xF;
       o[1] = xy[i] >> 4;
       o[2] = z[i];
-      if (o[0] >= steps || o[1] >= steps || o[2] >= steps) return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
+      if (o[0] >= steps || o[1] >= steps || o[2] >= steps)
+        return DataLossError("submap point " + std::to_string(i) + ": offset out of range");
     }
     const int64_t x = static_cast<int64_t>(linear % static_cast<uint64_t>(extent.x()));
     const int64_t y = static_cast<int64_t>((linear / static_cast<uint64_t>(extent.x())) % static_cast<uint64_t>(extent.y()));
@@ -432,7 +440,9 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
                           static_cast<float>((lo.y() + y + off[1] / steps) * res),
                           static_cast<float>((lo.z() + zz + off[2] / steps) * res));
     // Each value comes back at the middle of its quantization step.
-    const auto value = [&](size_t k) { return static_cast<uint8_t>((values[k] << drop) | ((1 << drop) >> 1)); };
+    const auto value = [&](size_t k) {
+      return static_cast<uint8_t>((values[k] << drop) | ((1 << drop) >> 1));
+    };
     p.r = value(i);
     p.g = value((color ? n : 0) + i);
     p.b = value((color ? 2 * static_cast<size_t>(n) : 0) + i);

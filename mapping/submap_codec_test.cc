@@ -44,7 +44,8 @@ TEST(SubmapCodecTest, RoundTripKeepsMetadataQuantizedCloudAndOccupancy) {
       std::map<std::tuple<int, int, int>, CloudPoint> by_voxel;
       const double res = s.metadata().options.cloud_resolution;
       const auto voxel = [&](const Eigen::Vector3f& p) {
-        return std::make_tuple(static_cast<int>(std::floor(p.x() / res)), static_cast<int>(std::floor(p.y() / res)),
+        return std::make_tuple(static_cast<int>(std::floor(p.x() / res)),
+                               static_cast<int>(std::floor(p.y() / res)),
                                static_cast<int>(std::floor(p.z() / res)));
       };
       for (const CloudPoint& p : s.points()) by_voxel[voxel(p.p)] = p;
@@ -115,7 +116,8 @@ TEST(SubmapCodecTest, IntensityBitsTradeBytesForSteps) {
   for (const int bits : {0, 9}) {
     auto bytes = SubmapCodec::Encode(*WithWireBits(*original, 2, bits));
     ASSERT_FALSE(bytes.ok());
-    EXPECT_NE(bytes.status().message().find("wire_intensity_bits"), std::string::npos) << bytes.status().ToString();
+    EXPECT_NE(bytes.status().message().find("wire_intensity_bits"), std::string::npos)
+        << bytes.status().ToString();
   }
 }
 
@@ -124,7 +126,8 @@ TEST(SubmapCodecTest, RefusesOffsetBitsOutsideTheirRange) {
   for (const int bits : {0, 5}) {
     auto bytes = SubmapCodec::Encode(*WithWireBits(*submap, bits));
     ASSERT_FALSE(bytes.ok());
-    EXPECT_NE(bytes.status().message().find("wire_offset_bits"), std::string::npos) << bytes.status().ToString();
+    EXPECT_NE(bytes.status().message().find("wire_offset_bits"), std::string::npos)
+        << bytes.status().ToString();
   }
 }
 
@@ -211,7 +214,8 @@ TEST(SubmapCodecTest, RejectsCorruptInputWithAClearError) {
   bad[8] = 9;  // version
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version"), std::string::npos);
   bad[8] = 2;  // the previous format (4 offset bits always) is not read as this one
-  EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version 2 is not supported"), std::string::npos);
+  EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("version 2 is not supported"),
+            std::string::npos);
   bad = good;
   bad.back() ^= 1;
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("checksum"), std::string::npos);

@@ -84,9 +84,10 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
     const std::string& n = mission.robots[i];
     const int index = static_cast<int>(i);
     const bool rover = n.rfind("rover", 0) == 0;
-    sim->robots_.push_back(
-        rover ? MakeRover(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment)
-              : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration, mission.image_scale, tag, &deployment));
+    sim->robots_.push_back(rover ? MakeRover(sim->terrain_, n, index, seed, mission.duration,
+                                             mission.image_scale, tag, &deployment)
+                                 : MakeHexacopter(sim->terrain_, n, index, seed, mission.duration,
+                                                  mission.image_scale, tag, &deployment));
     if (rover && world.roof_tag_size > 0.0) AddRoofTag(index, world.roof_tag_size, &sim->robots_.back());
   }
   if (world.lander.size() == 2) {

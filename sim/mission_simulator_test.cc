@@ -175,7 +175,8 @@ TEST(MissionSimulatorTest, DeployedRobotsStartInFrontOfALanderTagAndSeeIt) {
     std::vector<uint8_t> left, right;
     (*sim)->RenderStereo(r, 1.0, 10, &left, &right);
     bool lander_tag = false;
-    for (const int id : DetectedTagIds(left, robot.stereo.left.intrinsics)) lander_tag = lander_tag || (id >= 200 && id <= 203);
+    for (const int id : DetectedTagIds(left, robot.stereo.left.intrinsics))
+      lander_tag = lander_tag || (id >= 200 && id <= 203);
     EXPECT_TRUE(lander_tag) << robot.name << " does not see a lander tag";
     EXPECT_GT(robot.trajectory.Evaluate(35.0).velocity.norm(), 0.2) << robot.name << " never set out";
   }
@@ -211,15 +212,19 @@ TEST(MissionSimulatorTest, ARoofTagIsSeenFromAboveAndNotByItsRover) {
   Eigen::Isometry3d T_world_hexacopter = T_world_rover;
   T_world_hexacopter.translation() += T_world_rover.linear() * Eigen::Vector3d(-2.2, 0.0, 4.0);
   std::vector<uint8_t> above;
-  CameraRenderer::Render(scene, cam.intrinsics, T_world_hexacopter * cam.T_body_cam, m.render, 1, &above, nullptr);
+  CameraRenderer::Render(scene, cam.intrinsics, T_world_hexacopter * cam.T_body_cam, m.render, 1, &above,
+                         nullptr);
   const std::vector<int> seen = DetectedTagIds(above, cam.intrinsics);
-  EXPECT_NE(std::find(seen.begin(), seen.end(), 3), seen.end()) << "the hexacopter does not find the roof tag";
+  EXPECT_NE(std::find(seen.begin(), seen.end(), 3), seen.end())
+      << "the hexacopter does not find the roof tag";
   // The rover's own left camera.
   std::vector<uint8_t> own;
   const CameraCalibration& rover_cam = rover.stereo.left;
-  CameraRenderer::Render(scene, rover_cam.intrinsics, T_world_rover * rover_cam.T_body_cam, m.render, 2, &own, nullptr);
+  CameraRenderer::Render(scene, rover_cam.intrinsics, T_world_rover * rover_cam.T_body_cam, m.render, 2, &own,
+                         nullptr);
   const std::vector<int> own_seen = DetectedTagIds(own, rover_cam.intrinsics);
-  EXPECT_EQ(std::find(own_seen.begin(), own_seen.end(), 3), own_seen.end()) << "the rover sees its own roof tag";
+  EXPECT_EQ(std::find(own_seen.begin(), own_seen.end(), 3), own_seen.end())
+      << "the rover sees its own roof tag";
   // Without the key's tag (0), rovers carry none.
   WorldOptions bare = SmallWorld(3);
   bare.roof_tag_size = 0.0;

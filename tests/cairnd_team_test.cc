@@ -350,10 +350,13 @@ TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
     const JsonValue t = JsonValue::ParseFile(dir + "/" + m->name + "/team.json");
     double sent = 0.0;
     for (const JsonValue& peer : t["peers"].array()) sent += peer["sent_bytes"].number();
-    const double seconds = JsonValue::ParseFile(dir + "/" + m->name + "/summary.json")["streams"]["imu"]["duration_s"].number();
+    const double seconds =
+        JsonValue::ParseFile(dir + "/" + m->name + "/summary.json")["streams"]["imu"]["duration_s"].number();
     char line[160];
-    std::snprintf(line, sizeof(line), "sent per second of the 8 s mission: %.2f KB/s per link (mean over 1), %.2f KB/s over all links",
-                  sent / 1e3 / seconds, sent / 1e3 / seconds);
+    std::snprintf(
+        line, sizeof(line),
+        "sent per second of the 8 s mission: %.2f KB/s per link (mean over 1), %.2f KB/s over all links",
+        sent / 1e3 / seconds, sent / 1e3 / seconds);
     EXPECT_NE(summary.output.find(line), std::string::npos) << line << "\n" << summary.output;
   }
 }

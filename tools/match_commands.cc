@@ -153,11 +153,12 @@ int RunBenchMatch(const CommandArgs& args) {
       wire_bits = v;
       ++i;
     } else if (a.empty() || a[0] == '-') {
-      std::fprintf(stderr,
-                   "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
-                   "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
-                   "  --wire-bits: first send every submap through the wire format at these bit counts\n"
-                   "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n");
+      std::fprintf(
+          stderr,
+          "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
+          "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
+          "  --wire-bits: first send every submap through the wire format at these bit counts\n"
+          "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n");
       return 2;
     } else {
       dirs.push_back(a);
@@ -181,10 +182,11 @@ int RunBenchMatch(const CommandArgs& args) {
       m.options.wire_intensity_bits = static_cast<int64_t>(wire_bits[1]);
       const Submap coarse(m, s.submap->points(), std::make_unique<octomap::OcTree>(s.submap->tree()));
       auto bytes = SubmapCodec::Encode(coarse);
-      auto back = bytes.ok() ? SubmapCodec::Decode(*bytes) : Expected<std::shared_ptr<const Submap>>(bytes.status());
+      auto back =
+          bytes.ok() ? SubmapCodec::Decode(*bytes) : Expected<std::shared_ptr<const Submap>>(bytes.status());
       if (!back.ok()) {
-        std::fprintf(stderr, "cairn bench match: %s/%llu: %s\n", s.robot.c_str(), static_cast<unsigned long long>(s.id),
-                     back.status().ToString().c_str());
+        std::fprintf(stderr, "cairn bench match: %s/%llu: %s\n", s.robot.c_str(),
+                     static_cast<unsigned long long>(s.id), back.status().ToString().c_str());
         return 1;
       }
       s.submap = *back;

@@ -100,9 +100,11 @@ void PrintTeam(const std::string& dir, double mission_s) {
   // Per second of the mission rather than of the exchange, which runs faster or slower than the
   // mission in a replay and lingers after it.
   if (mission_s > 0.0 && !t["peers"].array().empty()) {
-    std::printf("    sent per second of the %.0f s mission: %.2f KB/s per link (mean over %zu), %.2f KB/s over all links\n",
-                mission_s, sent / 1e3 / mission_s / static_cast<double>(t["peers"].array().size()),
-                t["peers"].array().size(), sent / 1e3 / mission_s);
+    std::printf(
+        "    sent per second of the %.0f s mission: %.2f KB/s per link (mean over %zu), %.2f KB/s over all "
+        "links\n",
+        mission_s, sent / 1e3 / mission_s / static_cast<double>(t["peers"].array().size()),
+        t["peers"].array().size(), sent / 1e3 / mission_s);
   }
   std::vector<TeamTrajectory> team;
   std::string not_connected;
