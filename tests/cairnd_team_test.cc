@@ -350,8 +350,12 @@ TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
     const JsonValue t = JsonValue::ParseFile(dir + "/" + m->name + "/team.json");
     double sent = 0.0;
     for (const JsonValue& peer : t["peers"].array()) sent += peer["sent_bytes"].number();
-    const double seconds =
-        JsonValue::ParseFile(dir + "/" + m->name + "/summary.json")["streams"]["imu"]["duration_s"].number();
+    // The mission is its longest stream, as the summary takes it.
+    double seconds = 0.0;
+    const JsonValue streams = JsonValue::ParseFile(dir + "/" + m->name + "/summary.json")["streams"];
+    for (const auto& [name, stream] : streams.object()) {
+      if (stream.has("duration_s")) seconds = std::max(seconds, stream["duration_s"].number());
+    }
     char line[160];
     std::snprintf(
         line, sizeof(line),
