@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +54,16 @@ std::string ReadSome(int fd, size_t n, int timeout_ms) {
   return out;
 }
 
+// The proxy counts a chunk after write() returns, so the far end may hold the bytes a moment
+// before the count does.
+uint64_t ForwardedAfterSettling(const TcpLinkProxy& proxy, uint64_t expected) {
+  const auto end = Clock::now() + std::chrono::seconds(2);
+  while (proxy.forwarded_bytes() < expected && Clock::now() < end) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return proxy.forwarded_bytes();
+}
+
 int BasePort() { return 40000 + static_cast<int>(getpid() % 4000) * 4; }
 
 TEST(TcpLinkProxyTest, BytesArriveBothWaysAfterTheDelay) {
@@ -71,7 +82,7 @@ TEST(TcpLinkProxyTest, BytesArriveBothWaysAfterTheDelay) {
   EXPECT_GE(Clock::now() - sent, std::chrono::milliseconds(300));
   ASSERT_EQ(write(accepted, "back", 4), 4);
   EXPECT_EQ(ReadSome(client, 4, 2000), "back");
-  EXPECT_EQ(proxy.forwarded_bytes(), 9u);
+  EXPECT_EQ(ForwardedAfterSettling(proxy, 9), 9u);
   close(client);
   close(accepted);
   close(server);
