@@ -118,7 +118,8 @@ TEST(MissionSimulatorTest, SameSeedGivesIdenticalBytesOtherSeedDoesNot) {
 
 // A seed names one mission on every compiler and board: the draws happen in a fixed order, not in
 // the order a compiler happens to evaluate a call's arguments (GCC and Clang differ). The values
-// were recorded from a build; Clang drew another rover loop and other IMU noise before.
+// were recorded from a build (again when rovers began keeping off steep ground); Clang drew another
+// rover loop and other IMU noise before.
 TEST(MissionSimulatorTest, SeedNamesTheSameMissionOnEveryCompiler) {
   MissionOptions m;
   m.robots = {"rover"};
@@ -129,10 +130,10 @@ TEST(MissionSimulatorTest, SeedNamesTheSameMissionOnEveryCompiler) {
   auto sim = MissionSimulator::Create(world, m);
   ASSERT_TRUE(sim.ok()) << sim.status().ToString();
   const Eigen::Vector3d start = (*sim)->robots()[0].trajectory.Evaluate(0.0).T_world_body.translation();
-  EXPECT_LT((start - Eigen::Vector3d(-7.386038925, -4.772760983, 0.721722601)).norm(), 1e-8);
+  EXPECT_LT((start - Eigen::Vector3d(-6.000219626, -4.198735834, 1.395738667)).norm(), 1e-8);
   const ImuSample first = (*sim)->ImuStream(0).front().sample;
   EXPECT_LT((first.gyro - Eigen::Vector3d(-0.00584304477957, -0.00870397924792, -0.0177139926921)).norm(), 1e-12);
-  EXPECT_LT((first.accel - Eigen::Vector3d(-0.24315503448, -0.298375721158, 9.80323323891)).norm(), 1e-10);
+  EXPECT_LT((first.accel - Eigen::Vector3d(-0.281784870559, -1.27624210997, 9.72391520995)).norm(), 1e-10);
 }
 
 TEST(MissionSimulatorTest, RobotsSeeEachOther) {

@@ -155,48 +155,76 @@ SimRobot MakeRover(const Terrain& terrain, const std::string& name, int index, u
   // the order GCC's builds always drew, so earlier missions keep their paths).
   const double center_y = rng.Uniform(-3, 3);
   const double center_x = rng.Uniform(-3, 3);
-  const Eigen::Vector2d center(std::clamp(center_x + 4.0 * index, -limit + R0, limit - R0),
-                               std::clamp(center_y, -limit + R0, limit - R0));
+  const Eigen::Vector2d drawn(center_x + 4.0 * index, center_y);
   const double speed = 0.4, wobble = 0.15;
-  auto xy_at = [&](double s) {
-    const double th = phase + s / R0;
-    const double rad = R0 * (1 + wobble * std::sin(2 * th + phase));
-    return Eigen::Vector2d(center + rad * Eigen::Vector2d(std::cos(th), std::sin(th)));
-  };
   const int n = static_cast<int>(std::ceil(duration / kKnot)) + 4;
-  std::vector<Eigen::Vector3d> pos, euler;
   // It stands still before it drives off, as a rover does until its estimator has initialized
   // (wheels turning hold the filter's static initialization back).
   const double still = 2.0;  // s
-  const PlanarPath loop = [&](double t) { return xy_at(speed * t); };
-  std::optional<DeployPlan> plan;
-  // In front of a lander tag: the camera (1.3 m up, 25 deg down) sees the tag, 0.7 m up, from 1.6 m.
-  if (deployment != nullptr && deployment->enabled) {
-    plan = PlanDeployment(deployment, loop, 2 * kPi * R0 / speed, 2.6, still, speed, false);
-  }
-  for (int i = 0; i < n; ++i) {
-    Eigen::Vector2d p;
-    double yaw = 0.0;
-    if (plan) {
-      std::tie(p, yaw) = DeployedPose(*plan, loop, kKnot * (i - 1));
-    } else {
-      const double s = speed * std::max(0.0, kKnot * (i - 1) - still);
-      const Eigen::Vector2d ahead = xy_at(s + 0.05) - xy_at(s - 0.05);
-      p = xy_at(s);
-      yaw = std::atan2(ahead.y(), ahead.x());
+  // The rover's poses (control points) around a loop centred at `c`, and the steepest tilt of the
+  // ground under its wheels along them.
+  struct Drive {
+    std::vector<Eigen::Vector3d> pos, euler;
+    double max_tilt = 0.0;
+    Deployment deployment;
+  };
+  const auto drive_around = [&](const Eigen::Vector2d& c) {
+    Drive d;
+    const Eigen::Vector2d center(std::clamp(c.x(), -limit + R0, limit - R0),
+                                 std::clamp(c.y(), -limit + R0, limit - R0));
+    const auto xy_at = [&](double s) {
+      const double th = phase + s / R0;
+      const double rad = R0 * (1 + wobble * std::sin(2 * th + phase));
+      return Eigen::Vector2d(center + rad * Eigen::Vector2d(std::cos(th), std::sin(th)));
+    };
+    const PlanarPath loop = [&](double t) { return xy_at(speed * t); };
+    std::optional<DeployPlan> plan;
+    // In front of a lander tag: the camera (1.3 m up, 25 deg down) sees the tag, 0.7 m up, from 1.6 m.
+    if (deployment != nullptr && deployment->enabled) {
+      d.deployment = *deployment;
+      plan = PlanDeployment(&d.deployment, loop, 2 * kPi * R0 / speed, 2.6, still, speed, false);
     }
-    const Eigen::Rotation2Dd R(yaw);
-    double hw[4];
-    for (size_t w = 0; w < 4; ++w) {
-      const Eigen::Vector2d pw = p + R * r.wheels[w].head<2>();
-      hw[w] = terrain.Height(pw.x(), pw.y());
+    for (int i = 0; i < n; ++i) {
+      Eigen::Vector2d p;
+      double yaw = 0.0;
+      if (plan) {
+        std::tie(p, yaw) = DeployedPose(*plan, loop, kKnot * (i - 1));
+      } else {
+        const double s = speed * std::max(0.0, kKnot * (i - 1) - still);
+        const Eigen::Vector2d ahead = xy_at(s + 0.05) - xy_at(s - 0.05);
+        p = xy_at(s);
+        yaw = std::atan2(ahead.y(), ahead.x());
+      }
+      const Eigen::Rotation2Dd R(yaw);
+      double hw[4];
+      for (size_t w = 0; w < 4; ++w) {
+        const Eigen::Vector2d pw = p + R * r.wheels[w].head<2>();
+        hw[w] = terrain.Height(pw.x(), pw.y());
+      }
+      // Wheels: 0 front-left, 1 front-right, 2 rear-left, 3 rear-right.
+      const double pitch = std::atan2((hw[2] + hw[3]) - (hw[0] + hw[1]), 2 * 0.7);
+      const double roll = std::atan2((hw[0] + hw[2]) - (hw[1] + hw[3]), 2 * 0.66);
+      d.pos.emplace_back(p.x(), p.y(), (hw[0] + hw[1] + hw[2] + hw[3]) / 4 + 0.3);
+      d.euler.emplace_back(yaw, pitch, roll);
+      d.max_tilt = std::max(d.max_tilt, std::acos(std::cos(pitch) * std::cos(roll)));
     }
-    // Wheels: 0 front-left, 1 front-right, 2 rear-left, 3 rear-right.
-    const double pitch = std::atan2((hw[2] + hw[3]) - (hw[0] + hw[1]), 2 * 0.7);
-    const double roll = std::atan2((hw[0] + hw[2]) - (hw[1] + hw[3]), 2 * 0.66);
-    pos.emplace_back(p.x(), p.y(), (hw[0] + hw[1] + hw[2] + hw[3]) / 4 + 0.3);
-    euler.emplace_back(yaw, pitch, roll);
+    return d;
+  };
+  // A rover's planner keeps it off ground that tilts it more than this (the big crater's walls
+  // reach 70 deg, and a rover driven down them faces its unlit inside, blind). The drawn loop is
+  // kept when it is drivable; else the nearest drivable one, its centre moved in 0.5 m steps in 16
+  // directions; else the least steep of those.
+  constexpr double kMaxTilt = 25 * kPi / 180;
+  Drive chosen = drive_around(drawn);
+  for (int step = 1; step <= 40 && chosen.max_tilt > kMaxTilt; ++step) {
+    for (int k = 0; k < 16 && chosen.max_tilt > kMaxTilt; ++k) {
+      const double a = 2 * kPi * k / 16;
+      Drive d = drive_around(drawn + 0.5 * step * Eigen::Vector2d(std::cos(a), std::sin(a)));
+      if (d.max_tilt < chosen.max_tilt) chosen = std::move(d);
+    }
   }
+  if (deployment != nullptr && deployment->enabled) *deployment = chosen.deployment;
+  std::vector<Eigen::Vector3d> pos = std::move(chosen.pos), euler = std::move(chosen.euler);
   r.trajectory = BSplineTrajectory(kKnot, std::move(pos), UnwrapYaw(std::move(euler)));
   // Body and camera mast, and three tags tilted 40 deg upwards around the mast.
   r.boxes.push_back({Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.0)), {0.45, 0.35, 0.15}, 0.35f});

@@ -156,7 +156,15 @@ TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
   // One large crater with steep inner walls: a cliff-like negative edge for the classifier.
   if (o.big_crater) {
     const double r = std::min(10.0, o.size / 6);
-    const double cx = rng.Uniform(-half / 2, half / 2), cy = rng.Uniform(-half / 2, half / 2);
+    double cx = rng.Uniform(-half / 2, half / 2), cy = rng.Uniform(-half / 2, half / 2);
+    // A lander does not set down in it: its wall stays clear of the landing site (redrawn,
+    // a bounded number of times, while it is not).
+    for (int k = 0; k < 64 && o.lander.size() == 2 &&
+                    std::hypot(cx - o.lander[0], cy - o.lander[1]) < r + 1.5 * o.landing_site;
+         ++k) {
+      cx = rng.Uniform(-half / 2, half / 2);
+      cy = rng.Uniform(-half / 2, half / 2);
+    }
     const double depth = 0.3 * r, rim = 0.08 * r;
     Stamp(t.heights, n, half, res, cx, cy, r, 1.8, [&](double s) {
       const double s8 = std::pow(s, 8.0);
