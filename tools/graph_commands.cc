@@ -26,16 +26,20 @@ namespace {
 constexpr const char* kSolveUsage =
     "usage: cairn graph solve IN.g2o|DIR [--out OUT.g2o] [--objective geodesic|sesync]\n"
     "                         [--init chordal|odometry|file] [--loss none|cauchy:C]\n"
-    "                         [--outliers none|pcm|gnc] [--pcm-confidence P (probability that all true pairs pass, 0.99)]\n"
+    "                         [--outliers none|pcm|gnc] [--pcm-confidence P (probability that all true pairs "
+    "pass, 0.99)]\n"
     "                         [--noise-scale auto|S (outlier thresholds in units of the estimated noise,\n"
     "                          or of S times the variance the information states; auto)]\n"
     "                         [--injected-after N (edges from index N on are false: prints recall)]\n"
     "                         [--threads N] [--verbose]\n"
+    "                         [--project-information (information that is not positive definite:\n"
+    "                          use the nearest positive-definite matrix; else only --objective sesync takes "
+    "it)]\n"
     "                         [--tolerance REL (relative cost change that ends the solve)]\n"
     "                         [--reference SOLVED.g2o (prints the ATE against its vertices)]\n";
 
 bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, std::string& reference,
-                    long long& injected_after, PoseGraphSolverOptions& o) {
+                    long long& injected_after, bool& project, PoseGraphSolverOptions& o) {
   using O = PoseGraphSolverOptions;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
@@ -43,6 +47,10 @@ bool ParseSolveArgs(const CommandArgs& args, std::string& in, std::string& out, 
     const std::string v = has_value ? args.args[i + 1] : "";
     if (a == "--verbose") {
       o.verbose = true;
+      continue;
+    }
+    if (a == "--project-information") {
+      project = true;
       continue;
     }
     if (a.rfind("--", 0) != 0) {
@@ -117,13 +125,35 @@ int RunGraphSolve(const CommandArgs& args) {
   std::string in, out, reference;
   long long injected_after = -1;
   PoseGraphSolverOptions options;
-  if (!ParseSolveArgs(args, in, out, reference, injected_after, options)) {
+  bool project = false;
+  if (!ParseSolveArgs(args, in, out, reference, injected_after, project, options)) {
     std::fputs(kSolveUsage, stderr);
     return 2;
   }
   auto graph = ReadG2o(in);
   if (!graph.ok()) {
     std::fprintf(stderr, "cairn graph solve: %s\n", graph.status().message().c_str());
+    return 1;
+  }
+  if (const size_t indefinite = graph->indefinite_edges(); indefinite > 0 && project) {
+    for (PoseGraphEdge& e : graph->edges()) {
+      if (!e.definite) ProjectToPositiveDefinite(e);
+    }
+    std::fprintf(stderr,
+                 "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s): "
+                 "using the nearest positive-definite matrices\n",
+                 indefinite, graph->edges().size(), graph->first_indefinite().c_str());
+  } else if (indefinite > 0 && options.objective == PoseGraphSolverOptions::Objective::kSeSync) {
+    std::fprintf(stderr,
+                 "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s): "
+                 "the SE-Sync objective uses only their isotropic precisions\n",
+                 indefinite, graph->edges().size(), graph->first_indefinite().c_str());
+  } else if (indefinite > 0) {
+    std::fprintf(stderr,
+                 "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s); "
+                 "the geodesic objective needs it: use --objective sesync (their isotropic precisions) or "
+                 "--project-information (the nearest positive-definite matrices)\n",
+                 indefinite, graph->edges().size(), graph->first_indefinite().c_str());
     return 1;
   }
   // Loop closures before the rest are lost with the edges the solve may drop.

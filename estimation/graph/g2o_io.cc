@@ -108,7 +108,15 @@ Status ParseG2o(const std::string& text, const std::string& name, PoseGraph& gra
       }
       e.planar = false;
       if (e.information.llt().info() != Eigen::Success) {
-        return LineError(name, number, "information matrix is not positive definite");
+        // Only the SE-Sync objective can use it: its isotropic precisions need the two blocks alone.
+        if (e.information.topLeftCorner<3, 3>().llt().info() != Eigen::Success ||
+            e.information.bottomRightCorner<3, 3>().llt().info() != Eigen::Success) {
+          return LineError(
+              name, number,
+              "information matrix is not positive definite, nor are its translation and rotation blocks");
+        }
+        e.definite = false;
+        if (graph.first_indefinite().empty()) graph.set_first_indefinite(name + ":" + std::to_string(number));
       }
       PoseGraph::SetIsotropicWeights(e);
       bool duplicate = false;

@@ -1,5 +1,6 @@
 #include "estimation/graph/g2o_io.h"
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -68,6 +69,37 @@ TEST(G2oIoTest, RejectsMalformedLinesWithFileAndLine) {
     ASSERT_FALSE(s.ok()) << c.text;
     EXPECT_NE(s.message().find(c.what), std::string::npos) << s.message();
   }
+}
+
+// Some benchmark files carry information that is not positive definite while its translation and
+// rotation blocks are: read, flagged and counted (only the SE-Sync objective can use them); blocks
+// that are not positive definite themselves are refused at their line.
+TEST(G2oIoTest, IndefiniteInformationIsFlaggedWithWhereItWasFirstRead) {
+  // t_x and r_x coupled by 150 with 100 and 100 on the diagonal: eigenvalues -50 and 250.
+  const std::string indefinite =
+      "EDGE_SE3:QUAT 1 2 1 0 0 0 0 0 1 100 0 0 150 0 0 100 0 0 0 0 100 0 0 0 100 0 0 100 0 100\n";
+  PoseGraph g;
+  ASSERT_TRUE(ParseG2o(std::string(kSe3) + indefinite + indefinite, "mem", g).ok());
+  ASSERT_EQ(g.edges().size(), 3u);
+  EXPECT_TRUE(g.edges()[0].definite);
+  EXPECT_FALSE(g.edges()[1].definite);
+  EXPECT_EQ(g.indefinite_edges(), 2u);
+  EXPECT_EQ(g.first_indefinite(), "mem:4");
+  EXPECT_NEAR(g.edges()[1].tau, 100.0, 1e-9);
+  EXPECT_NEAR(g.edges()[1].kappa, 50.0, 1e-9);
+  // Its statistics take what the SE-Sync objective weighs: diag(tau, 2 kappa).
+  EXPECT_NEAR(EffectiveInformation(g.edges()[1]).diagonal().norm(), std::sqrt(6.0) * 100.0, 1e-9);
+  PoseGraphEdge projected = g.edges()[1];
+  ProjectToPositiveDefinite(projected);
+  EXPECT_TRUE(projected.definite);
+  EXPECT_EQ(projected.information.llt().info(), Eigen::Success);
+  PoseGraph bad;
+  const Status s = ParseG2o(
+      "\nEDGE_SE3:QUAT 1 2 1 0 0 0 0 0 1 100 0 0 0 0 0 -1 0 0 0 0 100 0 0 0 100 0 0 100 0 100\n", "mem", bad);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("mem:2: information matrix is not positive definite, nor are its"),
+            std::string::npos)
+      << s.message();
 }
 
 TEST(G2oIoTest, ReadsMultiRobotDirectoryOnceEachInterRobotEdge) {

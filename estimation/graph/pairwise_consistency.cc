@@ -105,7 +105,8 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
       const Pose3 T_c_v = c.T_c_v.back() * graph.edges()[k].T_from_to;
       const Matrix6d A = Adjoint(T_c_v);
       c.T_c_v.push_back(T_c_v);
-      c.prefix.push_back(c.prefix.back() + A * Covariance(graph.edges()[k].information) * A.transpose());
+      c.prefix.push_back(c.prefix.back() +
+                         A * Covariance(EffectiveInformation(graph.edges()[k])) * A.transpose());
     }
     chain_of[v] = static_cast<int>(chains.size()) - 1;
     position[v] = static_cast<int>(chains.back().T_c_v.size()) - 1;
@@ -118,7 +119,7 @@ Expected<PairwiseConsistencyResult> FindConsistentLoopClosures(const PoseGraph& 
     if (IsOdometryEdge(e)) continue;
     ++result.loop_closures;
     const size_t a = graph.Find(e.from), b = graph.Find(e.to);
-    Closure c{k, position[a], position[b], e.T_from_to, Covariance(e.information)};
+    Closure c{k, position[a], position[b], e.T_from_to, Covariance(EffectiveInformation(e))};
     int ca = chain_of[a], cb = chain_of[b];
     if (ca > cb) {
       // z Exp(xi) inverted is z^-1 Exp(-Ad(z) xi).

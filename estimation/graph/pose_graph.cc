@@ -2,6 +2,8 @@
 
 #include <queue>
 
+#include <Eigen/Eigenvalues>
+
 #include "estimation/math/so3.h"
 
 namespace cairn {
@@ -35,6 +37,28 @@ void PoseGraph::SetIsotropicWeights(PoseGraphEdge& e) {
     e.tau = 3.0 / e.information.topLeftCorner<3, 3>().inverse().trace();
     e.kappa = 3.0 / (2.0 * e.information.bottomRightCorner<3, 3>().inverse().trace());
   }
+}
+
+Matrix6d EffectiveInformation(const PoseGraphEdge& e) {
+  if (e.definite) return e.information;
+  Vector6d d;
+  d << e.tau, e.tau, e.tau, 2 * e.kappa, 2 * e.kappa, 2 * e.kappa;
+  return d.asDiagonal();
+}
+
+void ProjectToPositiveDefinite(PoseGraphEdge& e) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(0.5 * (e.information + e.information.transpose()));
+  const double floor = 1e-9 * eig.eigenvalues().cwiseAbs().maxCoeff();
+  const Vector6d clamped = eig.eigenvalues().cwiseMax(floor);
+  e.information = eig.eigenvectors() * clamped.asDiagonal() * eig.eigenvectors().transpose();
+  e.definite = true;
+  PoseGraph::SetIsotropicWeights(e);
+}
+
+size_t PoseGraph::indefinite_edges() const {
+  size_t n = 0;
+  for (const auto& e : edges_) n += e.definite ? 0 : 1;
+  return n;
 }
 
 bool PoseGraph::planar() const {
@@ -100,7 +124,7 @@ double GeodesicChi2(const PoseGraph& g) {
   for (const auto& e : g.edges()) {
     const Vector6d err =
         GeodesicError(g.poses()[g.Find(e.from)], g.poses()[g.Find(e.to)], e.T_from_to);
-    chi2 += err.dot(e.information * err);
+    chi2 += err.dot(EffectiveInformation(e) * err);
   }
   return chi2;
 }

@@ -5,6 +5,7 @@
 // keeps its isotropic SE-Sync weights from the original 3x3 information.
 
 #include <cstdint>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -45,6 +46,10 @@ struct PoseGraphEdge {
   double kappa = 1.0;
   double tau = 1.0;
   bool planar = false;  // read from EDGE_SE2
+  // False when `information` is not positive definite (some benchmark files carry such blocks);
+  // its translation and rotation blocks still are, so kappa and tau exist (see
+  // indefinite_information.h).
+  bool definite = true;
 };
 
 class PoseGraph {
@@ -71,6 +76,10 @@ class PoseGraph {
   void set_has_initial_estimate(bool v) { has_estimate_ = v; }
   // Planar graphs (all edges from EDGE_SE2) are written back as SE2.
   bool planar() const;
+  // Edges whose information is not positive definite, and where the first was read ("file:line").
+  size_t indefinite_edges() const;
+  const std::string& first_indefinite() const { return first_indefinite_; }
+  void set_first_indefinite(const std::string& where) { first_indefinite_ = where; }
 
   // Connected components of the edge graph: component id per dense vertex index.
   std::vector<int> Components(int* count) const;
@@ -81,7 +90,16 @@ class PoseGraph {
   std::unordered_map<uint64_t, size_t> index_;
   std::vector<PoseGraphEdge> edges_;
   bool has_estimate_ = false;
+  std::string first_indefinite_;
 };
+
+// The information an edge's statistics use (geodesic chi-square, noise scale, PCM, GNC): its own
+// when positive definite, else diag(tau I, 2 kappa I), what the SE-Sync objective weighs it by
+// near the optimum (||R(theta) - I||_F^2 = 2 theta^2 to second order).
+Matrix6d EffectiveInformation(const PoseGraphEdge& e);
+// Replaces an edge's information by the nearest positive-definite matrix (eigenvalues raised to at
+// least 1e-9 of the largest one's magnitude) and recomputes its isotropic weights.
+void ProjectToPositiveDefinite(PoseGraphEdge& e);
 
 // Robot odometry: consecutive indices of one robot, from the lower to the higher.
 constexpr bool IsOdometryEdge(const PoseGraphEdge& e) {

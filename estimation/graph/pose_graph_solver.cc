@@ -38,6 +38,7 @@ PoseGraph KeptEdges(const PoseGraph& graph, const std::vector<bool>& keep) {
     if (keep[k]) kept.AddEdge(graph.edges()[k]);
   }
   kept.set_has_initial_estimate(graph.has_initial_estimate());
+  kept.set_first_indefinite(graph.first_indefinite());
   return kept;
 }
 
@@ -47,7 +48,7 @@ std::vector<double> LoopClosureChi2(const PoseGraph& graph) {
   for (const auto& e : graph.edges()) {
     if (!IsLoopClosure(e)) continue;
     const Vector6d r = GeodesicError(graph.poses()[graph.Find(e.from)], graph.poses()[graph.Find(e.to)], e.T_from_to);
-    r2.push_back(r.dot(e.information * r));
+    r2.push_back(r.dot(EffectiveInformation(e) * r));
   }
   return r2;
 }
@@ -184,7 +185,7 @@ Expected<PoseGraphSolveSummary> SolveKeptEdges(PoseGraph& graph, const PoseGraph
       const auto& e = kept.edges()[j++];
       if (!IsLoopClosure(e)) continue;
       const Vector6d r = GeodesicError(kept.poses()[kept.Find(e.from)], kept.poses()[kept.Find(e.to)], e.T_from_to);
-      if (r.dot(e.information * r) > threshold) {
+      if (r.dot(EffectiveInformation(e) * r) > threshold) {
         keep[k] = false;
         dropped = true;
         ++screened;
@@ -222,6 +223,14 @@ Expected<PoseGraphSolveSummary> SolvePoseGraph(PoseGraph& graph, const PoseGraph
   using Options = PoseGraphSolverOptions;
   if (options.init == Options::Init::kFile && !graph.has_initial_estimate()) {
     return FailedPreconditionError("--init file: the graph has no vertex estimates");
+  }
+  if (options.objective == Options::Objective::kGeodesic && graph.indefinite_edges() > 0) {
+    return FailedPreconditionError(
+        std::to_string(graph.indefinite_edges()) + " of " + std::to_string(graph.edges().size()) +
+        " edges have information that is not positive definite (first at " +
+        (graph.first_indefinite().empty() ? std::string("?") : graph.first_indefinite()) +
+        "): the geodesic objective needs it; the SE-Sync objective uses only their "
+        "isotropic precisions");
   }
   if (options.outliers == Options::Outliers::kGnc && options.noise_scale <= 0.0 && options.cauchy_c <= 0.0) {
     return SolveWithEstimatedScale(graph, options);

@@ -132,5 +132,80 @@ TEST(PoseGraphSolverTest, GncRejectsFalseLoopClosuresOnASyntheticGraph) {
   EXPECT_LT(worst, 1e-3);
 }
 
+// The SE-Sync objective weighs an edge by kappa and tau alone, so a graph whose information is
+// not positive definite (but whose blocks are) has the optimum of the same graph with
+// diag(tau I, 2 kappa I): solved both ways, the poses agree. The geodesic objective refuses it,
+// naming the count and where, unless the information is projected.
+TEST(PoseGraphSolverTest, IndefiniteInformationSolvesUnderSeSyncAsItsIsotropicPrecisions) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> n(0.0, 0.01);
+  std::vector<Pose3> truth(40);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const double a = 2 * M_PI * static_cast<double>(i) / 40.0;
+    truth[i] = {Eigen::Vector3d(8 * std::cos(a), 8 * std::sin(a), 0.05 * static_cast<double>(i)),
+                so3::ExpQuaternion(Eigen::Vector3d(0.02 * std::sin(a), 0, a + M_PI / 2))};
+  }
+  Matrix6d indefinite = 1e4 * Matrix6d::Identity();
+  for (int k = 0; k < 3; ++k) indefinite(k, k + 3) = indefinite(k + 3, k) = 1.5e4;  // eigenvalues -5e3, 2.5e4
+  PoseGraph g, isotropic;
+  auto add = [&](uint64_t i, uint64_t j, bool odd) {
+    PoseGraphEdge e;
+    e.from = i;
+    e.to = j;
+    e.T_from_to =
+        truth[i].Inverse() * truth[j] * Pose3{DrawVector3(n, rng), so3::ExpQuaternion(DrawVector3(n, rng))};
+    e.information = odd ? indefinite : Matrix6d(2e4 * Matrix6d::Identity());
+    PoseGraph::SetIsotropicWeights(e);
+    g.AddEdge(e);
+    e.definite = !odd;
+    e.information = EffectiveInformation(e);
+    e.definite = true;
+    isotropic.AddEdge(e);
+  };
+  for (uint64_t i = 0; i + 1 < truth.size(); ++i) add(i, i + 1, i % 2 == 1);
+  for (uint64_t i = 0; i + 8 < truth.size(); i += 4) add(i, i + 8, true);
+  add(39, 0, true);
+  // Through the file format, as a user's graph comes in.
+  PoseGraph read;
+  ASSERT_TRUE(ParseG2o(FormatG2o(g), "ring.g2o", read).ok());
+  EXPECT_EQ(read.indefinite_edges(), 28u);            // 19 odometry edges, 9 closures
+  EXPECT_EQ(read.first_indefinite(), "ring.g2o:42");  // after 40 vertices, the second edge
+
+  PoseGraphSolverOptions geodesic;
+  PoseGraph refused = read;
+  const auto no = SolvePoseGraph(refused, geodesic);
+  ASSERT_FALSE(no.ok());
+  EXPECT_NE(
+      no.status().message().find("28 of 48 edges have information that is not positive definite (first at "
+                                 "ring.g2o:42)"),
+      std::string::npos)
+      << no.status().message();
+
+  PoseGraphSolverOptions sesync;
+  sesync.objective = PoseGraphSolverOptions::Objective::kSeSync;
+  ASSERT_TRUE(SolvePoseGraph(read, sesync).ok());
+  ASSERT_TRUE(SolvePoseGraph(isotropic, sesync).ok());
+  double apart = 0.0, off_truth = 0.0;
+  for (size_t v = 0; v < truth.size(); ++v) {
+    const Pose3& a = read.poses()[read.Find(v)];
+    const Pose3& b = isotropic.poses()[isotropic.Find(v)];
+    apart = std::max(apart, (a.t - b.t).norm());
+    // Gauge: both anchor the first vertex; compare relative to it.
+    off_truth = std::max(
+        off_truth, ((read.poses()[read.Find(0)].Inverse() * a).t - (truth[0].Inverse() * truth[v]).t).norm());
+  }
+  EXPECT_LT(apart, 1e-6);
+  EXPECT_LT(off_truth, 0.2);
+  EXPECT_NEAR(SeSyncCost(read), SeSyncCost(isotropic), 1e-6 * SeSyncCost(isotropic));
+
+  // Projected to the nearest positive-definite matrices, the geodesic objective takes it.
+  PoseGraph projected = refused;
+  for (PoseGraphEdge& e : projected.edges()) {
+    if (!e.definite) ProjectToPositiveDefinite(e);
+  }
+  EXPECT_EQ(projected.indefinite_edges(), 0u);
+  EXPECT_TRUE(SolvePoseGraph(projected, geodesic).ok());
+}
+
 }  // namespace
 }  // namespace cairn
