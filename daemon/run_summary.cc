@@ -191,6 +191,8 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
       const GraphStageReport g = graph->report();
       j.Field("graph_detections", g.detections).Field("graph_landmark_observations", g.landmark_observations);
       j.Field("graph_pending", g.detections_pending).Field("graph_unplaced", g.detections_unplaced);
+      j.Field("graph_flipped", g.detections_flipped)
+          .Field("graph_against_gravity", g.detections_against_gravity);
     }
     j.Key("first_errors").BeginArray();
     for (const auto& e : r.errors) j.String(e);

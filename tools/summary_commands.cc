@@ -232,11 +232,19 @@ int RunSummary(const CommandArgs& args) {
       }
       if (s.has("detection")) {
         const JsonValue& d = s["detection"];
-        std::printf("  detection: %.0f images scanned, %.0f tags of teammates or landmarks (%.0f usable, %.0f refused); "
-                    "in the graph %.0f robot detections d, %.0f landmark observations o, %.0f pending, %.0f unplaced\n",
-                    d["images"].number(), d["tags"].number(), d["usable"].number(), d["refused"].number(),
-                    d["graph_detections"].number(), d["graph_landmark_observations"].number(),
-                    d["graph_pending"].number(), d["graph_unplaced"].number());
+        const auto count = [&](const char* key) {
+          return d.has(key) ? d[key].number() : 0.0;
+        };  // older runs lack some
+        std::printf(
+            "  detection: %.0f images scanned, %.0f tags of teammates or landmarks (%.0f usable, %.0f "
+            "refused); "
+            "in the graph %.0f robot detections d (%.0f as IPPE's other minimum, %.0f refused against "
+            "gravity), "
+            "%.0f landmark observations o, %.0f pending, %.0f unplaced\n",
+            d["images"].number(), d["tags"].number(), d["usable"].number(), d["refused"].number(),
+            d["graph_detections"].number(), count("graph_flipped"), count("graph_against_gravity"),
+            d["graph_landmark_observations"].number(), d["graph_pending"].number(),
+            d["graph_unplaced"].number());
       }
       const std::optional<Eigen::Isometry3d> T_world_est = PrintAccuracy(dir, "trajectory.tum", "accuracy vs ground truth");
       if (std::filesystem::exists(std::string(dir) + "/global_trajectory.tum"))

@@ -167,6 +167,8 @@ std::string TeamItemCodec::Detection(uint32_t incarnation, const TeamDetection& 
   m.set_landmark(d.landmark);
   m.set_tag_id(static_cast<uint32_t>(std::max(d.tag_id, 0)));
   SetPose(m.mutable_t_observer_observed(), d.T_observer_observed, &d.covariance);
+  if (d.has_alternative)
+    SetPose(m.mutable_t_observer_observed_alternative(), d.T_observer_observed_alternative, nullptr);
   m.set_distance(d.distance);
   m.set_view_angle(d.view_angle);
   return m.SerializeAsString();
@@ -303,6 +305,11 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       d.tag_id = static_cast<int>(std::min<uint32_t>(m.tag_id(), 1u << 20));
       CAIRN_RETURN_IF_ERROR(GetPose(m.t_observer_observed(), &d.T_observer_observed, &d.covariance, what));
       if (d.covariance.llt().info() != Eigen::Success) return DataLossError(what + ": the covariance is not positive definite");
+      d.has_alternative = m.has_t_observer_observed_alternative();
+      if (d.has_alternative) {
+        CAIRN_RETURN_IF_ERROR(GetPose(m.t_observer_observed_alternative(), &d.T_observer_observed_alternative,
+                                      nullptr, what + " (its other minimum)"));
+      }
       d.distance = std::isfinite(m.distance()) ? m.distance() : 0.0;
       d.view_angle = std::isfinite(m.view_angle()) ? m.view_angle() : 0.0;
       return in;

@@ -140,6 +140,18 @@ TEST(TeamItemCodecTest, DetectionNamesTheObservedRobotOrLandmark) {
   EXPECT_TRUE(got.T_observer_observed.isApprox(d.T_observer_observed, 1e-12));
   EXPECT_TRUE(got.covariance.isApprox(d.covariance, 1e-12));
   EXPECT_DOUBLE_EQ(got.distance, 4.2);
+  EXPECT_FALSE(got.has_alternative);
+  // IPPE's other minimum travels with it.
+  TeamDetection two = d;
+  two.has_alternative = true;
+  two.T_observer_observed_alternative =
+      d.T_observer_observed * Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitX());
+  auto both = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kDetection, TeamItemCodec::Detection(1, two)),
+                                    TestNames());
+  ASSERT_TRUE(both.ok()) << both.status().ToString();
+  EXPECT_TRUE(both->detection.has_alternative);
+  EXPECT_TRUE(
+      both->detection.T_observer_observed_alternative.isApprox(two.T_observer_observed_alternative, 1e-12));
 
   d.observed = "lander";
   d.landmark = true;

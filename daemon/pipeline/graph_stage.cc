@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
 #include <set>
 
 #include "common/monotonic_clock.h"
+#include "detection/gravity_agreement.h"
 
 namespace cairn {
 namespace {
@@ -406,6 +409,38 @@ uint64_t GraphStage::DetectionPose(char robot, uint32_t run, Timestamp time, con
   return key;
 }
 
+bool GraphStage::AgreesWithGravity(const TeamDetection& d, const Placed& observer, const Placed& observed,
+                                   Eigen::Isometry3d* T_observer_observed, std::string* chosen,
+                                   std::string* refused) {
+  // Each robot's roll and pitch, as its filter knows them from gravity: a conservative sigma for
+  // an IMU of the MTi-10 class. The gate is chi-square with 2 degrees of freedom at 99.9 %.
+  constexpr double kAttitudeSigma = 1.0 * std::numbers::pi / 180;
+  constexpr double kGate = 13.8;
+  const Eigen::Matrix3d cov = d.covariance.bottomRightCorner<3, 3>();
+  const Eigen::Matrix3d R_a = observer.T_frame_body.linear(), R_b = observed.T_frame_body.linear();
+  const GravityAgreement best =
+      GravityAgreementOf(R_a, R_b, d.T_observer_observed.linear(), cov, kAttitudeSigma);
+  if (best.mahalanobis2 <= kGate) return true;
+  const double degrees = best.angle * 180 / std::numbers::pi;
+  char text[160];
+  if (d.has_alternative) {
+    const GravityAgreement other =
+        GravityAgreementOf(R_a, R_b, d.T_observer_observed_alternative.linear(), cov, kAttitudeSigma);
+    if (other.mahalanobis2 <= kGate) {
+      *T_observer_observed = d.T_observer_observed_alternative;
+      std::snprintf(text, sizeof text, " (IPPE's other minimum: the best tilts %.1f deg off gravity)",
+                    degrees);
+      *chosen = text;
+      ++report_.detections_flipped;
+      return true;
+    }
+  }
+  std::snprintf(text, sizeof text, "tilts %.1f deg off the robots' gravity (%.1f sigma)%s", degrees,
+                std::sqrt(best.mahalanobis2), d.has_alternative ? ", as does the other minimum" : "");
+  *refused = text;
+  return false;
+}
+
 void GraphStage::RetryPendingDetections() {
   for (size_t i = 0; i < pending_detections_.size();) {
     DetectionRecord& rec = detection_records_[pending_detections_[i]];
@@ -432,6 +467,17 @@ void GraphStage::RetryPendingDetections() {
       ++i;  // the frame's switch factor is not in yet
       continue;
     }
+    Eigen::Isometry3d T_observer_observed = d.T_observer_observed;
+    std::string chosen;
+    if (!d.landmark) {
+      std::string refused;
+      if (!AgreesWithGravity(d, obs, tgt, &T_observer_observed, &chosen, &refused)) {
+        rec.status = "refused: " + refused;
+        ++report_.detections_against_gravity;
+        pending_detections_.erase(pending_detections_.begin() + static_cast<long>(i));
+        continue;
+      }
+    }
     SlamFactor f;
     f.a = DetectionPose(d.observer_letter, d.observer_run, d.time, obs, obs_cov);
     if (d.landmark) {
@@ -442,11 +488,14 @@ void GraphStage::RetryPendingDetections() {
       f.kind = FactorKind::kDetection;
       f.b = DetectionPose(d.observed_letter, observed_run, d.time, tgt, tgt_cov);
     }
-    f.z = ToPose3(d.T_observer_observed);
+    f.z = ToPose3(T_observer_observed);
     f.information = Floored(d.covariance).inverse();
     const size_t errors = report_.errors.size();
     if (Add(f)) {
-      rec.status = "factor";
+      rec.status = "factor" + chosen;
+      // The record shows the pose the graph holds.
+      if (!chosen.empty())
+        std::swap(rec.detection.T_observer_observed, rec.detection.T_observer_observed_alternative);
       ++(d.landmark ? report_.landmark_observations : report_.detections);
       Update();
     } else {

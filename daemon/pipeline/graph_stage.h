@@ -44,6 +44,8 @@ struct GraphStageReport {
   uint64_t landmark_observations = 0; // landmark observations o added
   uint64_t detections_pending = 0;    // waiting for a robot's estimates around their time
   uint64_t detections_unplaced = 0;   // no estimate of a robot at their time: never added
+  uint64_t detections_flipped = 0;    // added as IPPE's other minimum: only it agrees with gravity
+  uint64_t detections_against_gravity = 0;  // refused: neither minimum agrees with gravity
   // Estimates or switches the graph could not place: their frame is not connected to the chain
   // (an input was lost upstream). Counted, never guessed.
   uint64_t unplaced = 0;
@@ -191,6 +193,10 @@ class GraphStage {
   // Adds the pose variable of `robot` at `time` (once) with its factor v; returns its key.
   uint64_t DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose, const Matrix6d& covariance);
   void RetryPendingDetections();
+  // Whether a sighting of a robot agrees with both robots' gravity (their estimates' roll and
+  // pitch); if only IPPE's other minimum does, `T_observer_observed` becomes it and `chosen` says so.
+  bool AgreesWithGravity(const TeamDetection& d, const Placed& observer, const Placed& observed,
+                         Eigen::Isometry3d* T_observer_observed, std::string* chosen, std::string* refused);
   std::vector<std::string> landmarks_;
   std::vector<DetectionRecord> detection_records_;
   std::vector<size_t> pending_detections_;  // indices into detection_records_

@@ -1,6 +1,7 @@
 #include "daemon/pipeline/graph_stage.h"
 
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -379,6 +380,50 @@ TEST(GraphStageTest, ADetectionTiesATeammatesFloatingSubgraphToOurs) {
   }
   ASSERT_EQ(g.detections().size(), 1u);
   EXPECT_EQ(g.detections()[0].status, "factor");
+}
+
+// IPPE's flip tilts the seen tag: a sighting whose rotation turns b's up 60 deg away from a's is
+// taken as its other minimum when that one agrees with gravity, and refused when neither does.
+TEST(GraphStageTest, ASightingAgainstGravityTakesTheOtherMinimumOrIsRefused) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStage g(Options(), true);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 10)) g.OnTeamInput(in);
+  const Eigen::Isometry3d flip(
+      Eigen::AngleAxisd(60 * std::numbers::pi / 180, Eigen::Vector3d(1, 1, 0).normalized()));
+  TeamDetection flipped = Sighting(a, b, 40);
+  flipped.has_alternative = true;
+  flipped.T_observer_observed_alternative = flipped.T_observer_observed;  // the truth
+  flipped.T_observer_observed = flipped.T_observer_observed * flip;
+  g.AddDetection(flipped, true, "");
+  TeamDetection wrong = Sighting(a, b, 60);
+  wrong.has_alternative = true;
+  wrong.T_observer_observed = wrong.T_observer_observed * flip;
+  wrong.T_observer_observed_alternative = wrong.T_observer_observed * flip;
+  g.AddDetection(wrong, true, "");
+  TeamDetection single = Sighting(a, b, 70);
+  single.T_observer_observed = single.T_observer_observed * flip;
+  g.AddDetection(single, true, "");
+  g.AddDetection(Sighting(a, b, 80), true, "");  // a good one, with no alternative
+  g.Finish();
+  const auto& recs = g.detections();
+  ASSERT_EQ(recs.size(), 4u);
+  EXPECT_EQ(recs[0].status, "factor (IPPE's other minimum: the best tilts 60.0 deg off gravity)");
+  EXPECT_TRUE(recs[0].detection.T_observer_observed.isApprox(Sighting(a, b, 40).T_observer_observed, 1e-12));
+  EXPECT_EQ(recs[1].status.rfind("refused: tilts 60.0 deg off the robots' gravity", 0), 0u) << recs[1].status;
+  EXPECT_NE(recs[1].status.find("as does the other minimum"), std::string::npos) << recs[1].status;
+  EXPECT_EQ(recs[2].status.rfind("refused: tilts 60.0 deg", 0), 0u) << recs[2].status;
+  EXPECT_EQ(recs[3].status, "factor");
+  EXPECT_EQ(g.report().detections, 2u);
+  EXPECT_EQ(g.report().detections_flipped, 1u);
+  EXPECT_EQ(g.report().detections_against_gravity, 2u);
+  // The factor taken is the true one: b lands where it was, and the graph is consistent.
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_FALSE(tb.poses.empty());
+  EXPECT_LT((tb.poses[50].T_frame_body.translation() - (Offset() * b.T_world_body[50]).translation()).norm(),
+            0.05);
+  EXPECT_LT(g.report().chi2, 1.0);
 }
 
 TEST(GraphStageTest, DetectionsBetweenEstimatesAreInterpolatedAndUnplaceableOnesSayWhy) {

@@ -98,6 +98,9 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
     t.landmark = mount->landmark;
     t.tag_id = d.id;
     t.T_observer_observed = T_body_cam_ * pose->T_cam_tag * T_tag_carrier;
+    t.has_alternative = pose->has_alternative;
+    if (pose->has_alternative)
+      t.T_observer_observed_alternative = T_body_cam_ * pose->T_cam_tag_alternative * T_tag_carrier;
     t.covariance = CarrierCovariance(pose->covariance, T_tag_carrier);
     t.distance = pose->distance;
     t.view_angle = pose->view_angle;

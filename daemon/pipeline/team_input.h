@@ -74,6 +74,10 @@ struct TeamDetection {
   int tag_id = -1;
   Eigen::Isometry3d T_observer_observed = Eigen::Isometry3d::Identity();
   Matrix6d covariance = Matrix6d::Identity();
+  // IPPE's other minimum, when it found two (same covariance): the graph takes it instead where
+  // only it agrees with both robots' gravity.
+  bool has_alternative = false;
+  Eigen::Isometry3d T_observer_observed_alternative = Eigen::Isometry3d::Identity();
   double distance = 0.0;    // m, camera to tag
   double view_angle = 0.0;  // rad, tag normal to the line of sight
 };
