@@ -212,7 +212,10 @@ int RunBenchMap(const CommandArgs& args) {
       return 2;
     }
   }
+  // The default world without its lander: the landing site moves the big crater away and
+  // reshuffles the boulders this drive was laid out among.
   sim::WorldOptions world;
+  world.lander.clear();
   const sim::Terrain terrain = sim::Terrain::Generate(world);
   const StereoCamera cam = testing::RoverCamera(1.0);
   MappingOptions o;
