@@ -25,7 +25,7 @@ double MaxTilt(const SimRobot& robot, double duration) {
 }
 
 // Two rovers of a team deployed from the lander, as the demo's mission makes them, on the default
-// world of several seeds: in all of these the drawn loops crossed the big crater (tilting a rover up
+// world of several seeds: in each of them a drawn loop crossed the big crater (tilting a rover up
 // to 72 deg), and in seed 8 the lander stood inside it.
 TEST(SimRobotTest, RoversKeepOffGroundThatTiltsThemMoreThan25Degrees) {
   for (int seed = 1; seed <= 8; ++seed) {
