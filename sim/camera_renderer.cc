@@ -39,6 +39,8 @@ struct Object {
 // for wide-angle cameras (below kWideFocal px), whose pixels spread faster.
 constexpr int kTile = 8;
 constexpr double kWideFocal = 700.0;
+// Rays per pixel side over markers (their edges are what tag detection measures).
+constexpr int kMarkerSamples = 4;
 
 // Distance along the ray to a box in its own frame (slab test) and the hit face normal.
 double HitBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector3d& h,
@@ -411,7 +413,20 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
               const Eigen::Vector3d p = o + t * d;
               if (t >= t_best || std::abs(p.x()) > ob.half_extent.x() || std::abs(p.y()) > ob.half_extent.y()) continue;
               t_best = t;
-              object_albedo = MarkerAlbedo(*ob.marker, p.x(), p.y());
+              // A pixel integrates light over its area: averaging 4 x 4 rays through it puts the
+              // marker's inner edges where they are to a fraction of a pixel (one ray would snap
+              // them to pixel boundaries, half a pixel off at worst).
+              float sum = 0.0f;
+              for (int sv = 0; sv < kMarkerSamples; ++sv) {
+                for (int su = 0; su < kMarkerSamples; ++su) {
+                  const double du = (su + 0.5) / kMarkerSamples - 0.5, dv = (sv + 0.5) / kMarkerSamples - 0.5;
+                  const Eigen::Vector3d ds = ob.T_obj_world.linear() * world_ray(col_x[static_cast<size_t>(u)] + du / k.fx,
+                                                                                 yc + dv / k.fy);
+                  const Eigen::Vector3d ps = o + (-o.z() / std::min(ds.z(), -1e-12)) * ds;
+                  sum += MarkerAlbedo(*ob.marker, ps.x(), ps.y());
+                }
+              }
+              object_albedo = sum / (kMarkerSamples * kMarkerSamples);
               normal = ob.T_obj_world.linear().transpose() * Eigen::Vector3d::UnitZ();
               seen[j] = Seen::kObject;
             } else {

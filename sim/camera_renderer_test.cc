@@ -152,6 +152,7 @@ TEST(CameraRendererTest, MarkerFacingTheCameraShowsItsBits) {
   RenderOptions o;
   o.read_noise = 0.0;
   o.shot_noise = 0.0;
+  o.exposure = 0.4;  // white stays below saturation
   o.ambient = 0.2;
   std::vector<uint8_t> img;
   CameraRenderer::Render(scene, k, T_world_cam, o, 1, &img, nullptr);
@@ -167,6 +168,55 @@ TEST(CameraRendererTest, MarkerFacingTheCameraShowsItsBits) {
     const uint8_t value = at_module(2 + bit / 6, 2 + bit % 6);
     EXPECT_EQ(value > 60, white) << "bit " << bit << " value " << int(value);
   }
+}
+
+}  // namespace
+}  // namespace cairn::sim
+
+namespace cairn::sim {
+namespace {
+
+// A pixel averages the light over its area: one that a marker's white-to-black edge cuts at a
+// quarter of its width is three quarters white (one ray per pixel would make it all white, and
+// every edge would snap to pixel boundaries).
+TEST(CameraRendererTest, AMarkerEdgeThroughAPixelGivesItTheCoveredShare) {
+  const Terrain terrain = Terrain::Generate(SmallWorld());
+  PinholeRadTan k;
+  k.width = 320;
+  k.height = 240;
+  k.fx = k.fy = 200.0;
+  k.cx = 159.5;
+  k.cy = 119.5;
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  T_world_cam.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // looking along +x
+  T_world_cam.translation() = Eigen::Vector3d(0, 0, terrain.Height(0, 0) + 2.0);
+  // Face on at 2 m: marker x runs along image u at 100 px/m. The quiet ring ends and the black
+  // border starts at x = -4 modules; put that at u = 100.25.
+  const double module = (159.5 - 100.25) / 100.0 / 4.0;
+  SimMarker m;
+  m.id = 0;
+  m.size = 8.0 * module;
+  Eigen::Matrix3d R_face;
+  R_face << 0, 0, -1, -1, 0, 0, 0, 1, 0;
+  m.T_body_marker.linear() = R_face;
+  m.T_body_marker.translation() = T_world_cam.translation() + Eigen::Vector3d(2.0, 0.0, 0.0);
+  RenderScene scene;
+  scene.terrain = &terrain;
+  scene.sun_direction = Eigen::Vector3d(-1, 0, 0.2).normalized();
+  scene.markers.push_back(m);
+  RenderOptions o;
+  o.read_noise = 0.0;
+  o.shot_noise = 0.0;
+  o.exposure = 0.4;  // white stays below saturation
+  std::vector<uint8_t> img;
+  CameraRenderer::Render(scene, k, T_world_cam, o, 1, &img, nullptr);
+  const auto at = [&](int u) { return static_cast<double>(img[static_cast<size_t>(119 * k.width + u)]); };
+  const double white = at(98), black = at(102);
+  ASSERT_GT(white, 100.0);
+  // Albedo 0.85 white, 0.04 black: three quarters white is 0.6475.
+  EXPECT_NEAR((at(100) - black) / (white - black), 0.75, 0.04) << at(99) << " " << at(100) << " " << at(101);
+  EXPECT_NEAR(at(99), white, 1.0);
+  EXPECT_NEAR(at(101), black, 1.0);
 }
 
 }  // namespace
