@@ -198,7 +198,12 @@ int Cairnd::Run() {
       } else if (options_.source == SourceKind::kSim) {
         table = SimulatedTagCarriers(options_, config_path_);
       }
-      Status s = table.ok() ? pipeline.EnableDetection(options_.detection, std::move(*table), options_.robot.name)
+      // A relative error table is the profile's: configs/detection/ beside it, installed or not.
+      std::filesystem::path error_table = options_.detection.error_table;
+      if (!error_table.empty() && error_table.is_relative())
+        error_table = std::filesystem::path(config_path_).parent_path() / error_table;
+      Status s = table.ok() ? pipeline.EnableDetection(options_.detection, std::move(*table), options_.robot.name,
+                                                       error_table.string())
                             : table.status();
       if (!s.ok()) {
         spdlog::error("{}: detection: {}", config_path_, s.ToString());

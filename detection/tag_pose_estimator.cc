@@ -41,17 +41,23 @@ std::vector<std::pair<Eigen::Isometry3d, double>> TagPoseEstimator::Solve(
   const cv::Matx33d K(camera.fx, 0.0, camera.cx, 0.0, camera.fy, camera.cy, 0.0, 0.0, 1.0);
   const cv::Vec4d distortion(camera.k1, camera.k2, camera.p1, camera.p2);
   std::vector<cv::Mat> rvecs, tvecs;
-  cv::Mat errors;
   std::vector<std::pair<Eigen::Isometry3d, double>> out;
   try {
-    cv::solvePnPGeneric(object, image, K, distortion, rvecs, tvecs, false, cv::SOLVEPNP_IPPE_SQUARE, cv::noArray(),
-                        cv::noArray(), errors);
+    cv::solvePnPGeneric(object, image, K, distortion, rvecs, tvecs, false, cv::SOLVEPNP_IPPE_SQUARE);
   } catch (const cv::Exception&) {
     return out;  // degenerate corners (e.g. all on a line): no solution
   }
   for (size_t i = 0; i < rvecs.size(); ++i) {
-    const double e = errors.empty() ? 0.0 : errors.at<double>(static_cast<int>(i));
-    out.emplace_back(FromRvecTvec(rvecs[i], tvecs[i]), e);
+    // RMS over the 4 corners of the distance to the projection (computed here, so that its
+    // definition does not depend on OpenCV's).
+    std::vector<cv::Point2d> projected;
+    cv::projectPoints(object, rvecs[i], tvecs[i], K, distortion, projected);
+    double sse = 0.0;
+    for (size_t c = 0; c < 4; ++c) {
+      const cv::Point2d d = projected[c] - image[c];
+      sse += d.dot(d);
+    }
+    out.emplace_back(FromRvecTvec(rvecs[i], tvecs[i]), std::sqrt(sse / 4.0));
   }
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   return out;
@@ -119,6 +125,8 @@ Expected<TagPose> TagPoseEstimator::Estimate(const std::array<Eigen::Vector2d, 4
   for (int k = 0; k < 6; ++k)
     sigma[k] = std::max(sigma[k], k < 3 ? options_.min_sigma_translation : options_.min_sigma_rotation);
   pose.covariance = sigma.cwiseAbs2().asDiagonal();
+  for (size_t i = 0; i < n; ++i) pose.sample_covariance += (deviations[i] - mean) * (deviations[i] - mean).transpose();
+  pose.sample_covariance /= static_cast<double>(n);
   return pose;
 }
 

@@ -57,6 +57,10 @@ struct TagPose {
   double alternative_reprojection_error = 0.0;
   // Diagonal; the tangent described above. Zero when sampling is off.
   Matrix6d covariance = Matrix6d::Zero();
+  // The full sample covariance of the same 257 solutions. In the linear regime the +-delta
+  // combinations are a full factorial design, so this is exactly J diag(delta^2) J^T: the
+  // first-order propagation of independent corner errors of sigma delta.
+  Matrix6d sample_covariance = Matrix6d::Zero();
   int flipped_samples = 0;  // perturbed solutions nearer the alternative than the best
   double distance = 0.0;    // m, camera to tag centre
   double view_angle = 0.0;  // rad, between the tag's normal and the direction to the camera

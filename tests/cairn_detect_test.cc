@@ -51,6 +51,37 @@ TEST(CairnDetectTest, ARealPhotoHasItsTwelveTags) {
   EXPECT_EQ(JsonValue::Parse(r.output)["tags"].array().size(), 12u);
 }
 
+TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
+  const std::string dir = testing::FreshTempDir("cairn_detect_lut");
+  const std::string table = dir + "/rover.lut";
+  auto r = Detect({"build-lut", "--camera", "rover", "--out", table, "--distances", "1,4,2", "--angles", "0,40,2",
+                   "--samples", "3", "--seed", "5"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue built = JsonValue::Parse(r.output.substr(r.output.find('{')));
+  EXPECT_GE(built["rendered"].number(), 10);  // of 12: a near tag may not fit in 32 random places
+  EXPECT_GT(built["detected"].number(), 6);
+  EXPECT_GT(built["corner_rms_px"].number(), 0.0);
+  EXPECT_LT(built["corner_rms_px"].number(), 1.0);
+  r = Detect({"check-lut", table, "--samples", "12", "--seed", "6"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue checked = JsonValue::Parse(r.output.substr(r.output.find('{')));
+  EXPECT_EQ(checked["camera"].string(), "rover");
+  ASSERT_EQ(checked["models"].array().size(), 6u);
+  EXPECT_EQ(checked["models"][0]["model"].string(), "combined");
+  EXPECT_GT(checked["detected"].number(), 0);
+  for (const JsonValue& m : checked["models"].array()) EXPECT_GT(m["mean_nees"].number(), 0.0) << m["model"].string();
+  // Bad input: an unknown camera, a grid backwards, a table that is not one.
+  r = Detect({"build-lut", "--camera", "drone", "--out", table});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--camera must be rover or hexacopter, not 'drone'"), std::string::npos) << r.output;
+  r = Detect({"build-lut", "--camera", "rover", "--out", table, "--distances", "4,1,3"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--distances: bad value"), std::string::npos) << r.output;
+  r = Detect({"check-lut", testing::SourceDir() + "/configs/rover.yaml"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("rover.yaml:"), std::string::npos) << r.output;
+}
+
 TEST(CairnDetectTest, BadInputEndsWithAStatusNamingIt) {
   const std::string dir = testing::FreshTempDir("cairn_detect_bad");
   auto r = Detect({dir + "/none.png", "--intrinsics", "1,1,1,1"});

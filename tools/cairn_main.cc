@@ -53,6 +53,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"match", "match two submap files (4-DoF: keypoints, descriptors, RANSAC, ICP) and print T_a_b as JSON", RunMatch},
     {"bench match", "time submap matching on cairnd runs' submaps; recall and precision against the simulator", RunBenchMatch},
     {"detect", "AprilTag 36h11 tags in a photo: corners, T_cam_tag and its covariance as JSON", RunDetect},
+    {"detect build-lut", "the precomputed tag error table of one robot camera, from rendered tags", RunDetectBuildLut},
+    {"detect check-lut", "NEES of each tag error model and recall on rendered tags a table was not built from", RunDetectCheckLut},
     {"bench detect", "time AprilTag detection on simulated rover frames: whole frame and region of interest", RunBenchDetect},
     {"eval", "trajectory accuracy vs ground truth (TUM/EuRoC): ATE, RPE, drift as JSON", RunEval},
     {"bench vo", "visual-odometry time per stereo frame on an EuRoC/ASL folder (no SGM)", RunBenchVo},

@@ -49,6 +49,8 @@ int RunBenchVo(const CommandArgs& args);
 int RunMatch(const CommandArgs& args);
 int RunDetect(const CommandArgs& args);
 int RunBenchDetect(const CommandArgs& args);
+int RunDetectBuildLut(const CommandArgs& args);
+int RunDetectCheckLut(const CommandArgs& args);
 int RunBenchMatch(const CommandArgs& args);
 
 }  // namespace cairn::tools

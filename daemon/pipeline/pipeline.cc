@@ -96,13 +96,16 @@ Status Pipeline::EnableGraph(const GraphStageOptions& options) {
   return Status::Ok();
 }
 
-Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrierTable table, const std::string& robot) {
+Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrierTable table, const std::string& robot,
+                                 const std::string& error_table_path) {
   if (started_) return FailedPreconditionError("EnableDetection() after Start()");
   if (!graph_) return FailedPreconditionError("robot detection needs the graph enabled");
   if (table.empty()) return InvalidArgumentError("robot detection: the tag carrier table lists no tag");
   if (Status s = options.detector.Validate(); !s.ok()) return s.WithContext("detection.detector");
+  auto model = RobotDetectionStage::MakeErrorModel(options, error_table_path, rectify_->camera());
+  if (!model.ok()) return model.status();
   graph_->SetLandmarks(table.Landmarks());
-  detection_ = std::make_unique<RobotDetectionStage>(options, std::move(table), rectify_->camera(),
+  detection_ = std::make_unique<RobotDetectionStage>(options, std::move(table), std::move(*model), rectify_->camera(),
                                                      rectify_->T_body_cam(), robot, graph_->robot());
   detection_every_ = options.every_nth_frame;
   return Status::Ok();

@@ -18,6 +18,12 @@ struct RobotDetectionOptions {
   // takes the simulated world's.
   std::string carriers_file;
   double corner_error = 0.5;  // px, eq. 6.9's corner perturbation
+  // The covariance of a sighting (detection/tag_error_model.h): combined, thesis, table, online,
+  // constant or quadratic. Every model but online, constant and quadratic needs `error_table`,
+  // built for this robot's camera by `cairn detect build-lut` (a relative path is taken from the
+  // profile's folder).
+  std::string error_model = "combined";
+  std::string error_table;
   // Sightings beyond these are kept in detections.csv but not given to the graph (thesis 6.2.3:
   // far or edge-on tags flip between their two poses).
   double max_distance = 12.0;          // m, camera to tag
@@ -31,6 +37,8 @@ struct RobotDetectionOptions {
     v.Integer("every_nth_frame", every_nth_frame, 1, 1000, "frames");
     v.Text("carriers_file", carriers_file);
     v.Number("corner_error", corner_error, 0.0, 10.0, "px");
+    v.Text("error_model", error_model);
+    v.Text("error_table", error_table);
     v.Number("max_distance", max_distance, 0.1, 1000.0, "m");
     v.Number("max_sigma_translation", max_sigma_translation, 1e-4, 100.0, "m");
     v.Number("max_sigma_rotation", max_sigma_rotation, 1e-4, 3.2, "rad");

@@ -23,11 +23,37 @@ std::string Fixed(double v, int digits) {
 
 }  // namespace
 
+Expected<TagErrorModel> RobotDetectionStage::MakeErrorModel(const RobotDetectionOptions& options,
+                                                            const std::string& table_path,
+                                                            const RectifiedStereoCamera& camera) {
+  auto kind = ParseTagErrorKind(options.error_model);
+  if (!kind.ok()) return kind.status().WithContext("detection.error_model");
+  std::shared_ptr<const TagErrorTable> table;
+  double scale = 1.0;
+  if (!table_path.empty()) {
+    auto loaded = TagErrorTable::Load(table_path);
+    if (!loaded.ok()) return loaded.status().WithContext("detection.error_table");
+    // Same field of view (within 2 %), at most the table's resolution.
+    scale = camera.f / loaded->fx();
+    const double fov = camera.width / camera.f, table_fov = loaded->width() / loaded->fx();
+    if (std::abs(fov / table_fov - 1.0) > 0.02 || scale > 1.02)
+      return InvalidArgumentError("detection.error_table: " + table_path + " was built for a " +
+                                  std::to_string(loaded->width()) + " px wide camera of f = " + Fixed(loaded->fx(), 1) +
+                                  " px, this robot's rectified camera is " + std::to_string(camera.width) +
+                                  " px wide with f = " + Fixed(camera.f, 1) + " px (build one: cairn detect build-lut)");
+    table = std::make_shared<const TagErrorTable>(std::move(*loaded));
+  }
+  auto model = TagErrorModel::Create(*kind, std::move(table), options.corner_error, std::min(scale, 1.0));
+  if (!model.ok()) return model.status().WithContext("detection.error_model");
+  return model;
+}
+
 RobotDetectionStage::RobotDetectionStage(const RobotDetectionOptions& options, TagCarrierTable table,
-                                         const RectifiedStereoCamera& camera, const Eigen::Isometry3d& T_body_cam,
-                                         const std::string& robot, char letter)
+                                         TagErrorModel error_model, const RectifiedStereoCamera& camera,
+                                         const Eigen::Isometry3d& T_body_cam, const std::string& robot, char letter)
     : options_(options),
       table_(std::move(table)),
+      error_model_(std::move(error_model)),
       T_body_cam_(T_body_cam),
       robot_(robot),
       letter_(letter),
@@ -101,13 +127,14 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
     t.has_alternative = pose->has_alternative;
     if (pose->has_alternative)
       t.T_observer_observed_alternative = T_body_cam_ * pose->T_cam_tag_alternative * T_tag_carrier;
-    t.covariance = CarrierCovariance(pose->covariance, T_tag_carrier);
+    const Matrix6d tag_covariance = error_model_.Covariance(*pose, mount->size);
+    t.covariance = CarrierCovariance(tag_covariance, T_tag_carrier);
     t.distance = pose->distance;
     t.view_angle = pose->view_angle;
     double sigma_t = 0.0, sigma_r = 0.0;
     for (int i = 0; i < 3; ++i) {
-      sigma_t = std::max(sigma_t, std::sqrt(std::max(0.0, pose->covariance(i, i))));
-      sigma_r = std::max(sigma_r, std::sqrt(std::max(0.0, pose->covariance(i + 3, i + 3))));
+      sigma_t = std::max(sigma_t, std::sqrt(std::max(0.0, tag_covariance(i, i))));
+      sigma_r = std::max(sigma_r, std::sqrt(std::max(0.0, tag_covariance(i + 3, i + 3))));
     }
     if (pose->distance > options_.max_distance) {
       s.refused = "farther than " + Fixed(options_.max_distance, 1) + " m";

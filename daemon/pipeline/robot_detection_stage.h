@@ -1,6 +1,7 @@
 #pragma once
 // The detection executor's work: tags on the left rectified image (a whole-frame scan of every
-// `every_nth_frame`-th pair), each tag's pose by IPPE with eq. 6.9's uncertainty, and from the
+// `every_nth_frame`-th pair), each tag's pose by IPPE with the configured error model
+// (detection/tag_error_model.h), and from the
 // carrier table the observed robot's or landmark's body in this robot's body at the exposure time.
 // Tags of this robot itself and ids not in the table are counted and dropped; sightings beyond
 // the configured distance or uncertainty are handed on marked as refused, with the reason.
@@ -17,6 +18,7 @@
 #include "daemon/pipeline/team_input.h"
 #include "detection/tag_carrier_table.h"
 #include "detection/tag_detector.h"
+#include "detection/tag_error_model.h"
 #include "detection/tag_pose_estimator.h"
 #include "estimation/vo/vo_types.h"
 
@@ -42,8 +44,14 @@ struct RobotDetectionReport {
 
 class RobotDetectionStage {
  public:
-  RobotDetectionStage(const RobotDetectionOptions& options, TagCarrierTable table, const RectifiedStereoCamera& camera,
-                      const Eigen::Isometry3d& T_body_cam, const std::string& robot, char letter);
+  RobotDetectionStage(const RobotDetectionOptions& options, TagCarrierTable table, TagErrorModel error_model,
+                      const RectifiedStereoCamera& camera, const Eigen::Isometry3d& T_body_cam, const std::string& robot,
+                      char letter);
+
+  // The error model `options` name, for `camera`: loads the table (`table_path`, already resolved)
+  // and checks that it was built for a camera of this one's field of view.
+  static Expected<TagErrorModel> MakeErrorModel(const RobotDetectionOptions& options, const std::string& table_path,
+                                                const RectifiedStereoCamera& camera);
 
   // Appends a sighting for every tag of another carrier in the pair's left image.
   void Process(const RectifiedPair& pair, std::vector<TagSighting>* out);
@@ -58,6 +66,7 @@ class RobotDetectionStage {
  private:
   RobotDetectionOptions options_;
   TagCarrierTable table_;
+  TagErrorModel error_model_;
   PinholeRadTan camera_;
   Eigen::Isometry3d T_body_cam_;
   std::string robot_;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "detection/testing/rendered_tag.h"
+#include "tests/support/test_data.h"
 
 namespace cairn {
 namespace {
@@ -77,6 +78,13 @@ Eigen::Isometry3d TagInView(double distance, double yaw) {
   return T;
 }
 
+// The model the options name, with the rover's shipped table (this camera is the rover's).
+TagErrorModel ModelFor(const RobotDetectionOptions& o) {
+  auto m = RobotDetectionStage::MakeErrorModel(o, testing::SourceDir() + "/configs/detection/rover.lut", Camera());
+  EXPECT_TRUE(m.ok()) << m.status().ToString();
+  return *m;
+}
+
 RectifiedPair PairOf(const cv::Mat& left, int64_t time_ns) {
   RectifiedPair p;
   p.time = Timestamp::FromNanoseconds(time_ns);
@@ -87,7 +95,7 @@ RectifiedPair PairOf(const cv::Mat& left, int64_t time_ns) {
 
 TEST(RobotDetectionStageTest, ATeammatesTagGivesItsBodyInOursAtTheExposureTime) {
   const TagCarrierTable table = Table();
-  RobotDetectionStage stage(Options(), table, Camera(), BodyCam(), "hexacopter", 'b');
+  RobotDetectionStage stage(Options(), table, ModelFor(Options()), Camera(), BodyCam(), "hexacopter", 'b');
   const Eigen::Isometry3d T_cam_tag = TagInView(3.0, 25 * kDeg);
   const cv::Mat image = testing::RenderTag(10, 0.16, T_cam_tag, Pinhole());
   std::vector<TagSighting> out;
@@ -114,7 +122,7 @@ TEST(RobotDetectionStageTest, OwnTagsAreDroppedFarTagsRefusedLandmarksKept) {
   const TagCarrierTable table = Table();
   RobotDetectionOptions o = Options();
   o.max_distance = 3.5;
-  RobotDetectionStage stage(o, table, Camera(), BodyCam(), "rover", 'a');
+  RobotDetectionStage stage(o, table, ModelFor(o), Camera(), BodyCam(), "rover", 'a');
   cv::Mat image(508, 1024, CV_8UC1, cv::Scalar(128));
   Eigen::Isometry3d own = TagInView(2.0, 0.0);
   own.translation().x() = -0.6;
@@ -140,8 +148,37 @@ TEST(RobotDetectionStageTest, OwnTagsAreDroppedFarTagsRefusedLandmarksKept) {
   EXPECT_EQ(stage.report().refused, 1u);
 }
 
+TEST(RobotDetectionStageTest, AnErrorTableOfAnotherCameraOrAMissingOneIsRefusedAtStartUp) {
+  RobotDetectionOptions o = Options();
+  const std::string dir = testing::SourceDir() + "/configs/detection/";
+  // The hexacopter's table on the rover's camera: another field of view.
+  auto m = RobotDetectionStage::MakeErrorModel(o, dir + "hexacopter.lut", Camera());
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.status().message().find("detection.error_table: " + dir + "hexacopter.lut was built for a 666 px wide"),
+            std::string::npos)
+      << m.status().message();
+  // The rover's table on the rover's camera at half resolution is fine (same field of view).
+  RectifiedStereoCamera half = Camera();
+  half.width /= 2;
+  half.height /= 2;
+  half.f /= 2;
+  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, dir + "rover.lut", half).ok());
+  m = RobotDetectionStage::MakeErrorModel(o, dir + "nonexistent.lut", Camera());
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.status().message().find("nonexistent.lut"), std::string::npos);
+  m = RobotDetectionStage::MakeErrorModel(o, "", Camera());  // combined needs a table
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.status().message().find("needs an error table"), std::string::npos) << m.status().message();
+  o.error_model = "online";
+  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, "", Camera()).ok());
+  o.error_model = "gaussian";
+  m = RobotDetectionStage::MakeErrorModel(o, "", Camera());
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.status().message().find("detection.error_model"), std::string::npos) << m.status().message();
+}
+
 TEST(RobotDetectionStageTest, BadImagesAreCountedNotFatal) {
-  RobotDetectionStage stage(Options(), Table(), Camera(), BodyCam(), "rover", 'a');
+  RobotDetectionStage stage(Options(), Table(), ModelFor(Options()), Camera(), BodyCam(), "rover", 'a');
   std::vector<TagSighting> out;
   stage.Process(RectifiedPair{}, &out);
   EXPECT_TRUE(out.empty());

@@ -1,0 +1,89 @@
+#include "detection/tag_error_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cairn {
+namespace {
+
+struct KindName {
+  TagErrorKind kind;
+  const char* name;
+};
+constexpr KindName kKinds[] = {{TagErrorKind::kCombined, "combined"},
+                               {TagErrorKind::kThesis, "thesis"},
+                               {TagErrorKind::kTable, "table"},
+                               {TagErrorKind::kOnline, "online"},
+                               {TagErrorKind::kConstant, "constant"},
+                               {TagErrorKind::kQuadratic, "quadratic"}};
+
+}  // namespace
+
+Expected<TagErrorKind> ParseTagErrorKind(const std::string& name) {
+  for (const KindName& k : kKinds) {
+    if (name == k.name) return k.kind;
+  }
+  return InvalidArgumentError("tag error model '" + name + "' is not one of combined, thesis, table, online, constant, quadratic");
+}
+
+const char* TagErrorKindName(TagErrorKind kind) {
+  for (const KindName& k : kKinds) {
+    if (kind == k.kind) return k.name;
+  }
+  return "?";
+}
+
+Expected<TagErrorModel> TagErrorModel::Create(TagErrorKind kind, std::shared_ptr<const TagErrorTable> table,
+                                              double corner_error, double camera_scale) {
+  const bool needs_table = kind == TagErrorKind::kCombined || kind == TagErrorKind::kThesis || kind == TagErrorKind::kTable;
+  if (needs_table && (table == nullptr || table->empty()))
+    return InvalidArgumentError(std::string("tag error model '") + TagErrorKindName(kind) + "' needs an error table");
+  if (kind == TagErrorKind::kCombined && !(corner_error > 0.0))
+    return InvalidArgumentError("tag error model 'combined' needs a corner perturbation > 0 px");
+  if (!(camera_scale > 0.0 && camera_scale <= 1.0 + 1e-9))
+    return InvalidArgumentError("tag error model: camera scale " + std::to_string(camera_scale) + " is not in (0, 1]");
+  const double ratio = kind == TagErrorKind::kCombined ? table->corner_rms() / corner_error : 1.0;
+  return TagErrorModel(kind, std::move(table), ratio * ratio, camera_scale);
+}
+
+Matrix6d TagErrorModel::Covariance(const TagPose& pose, double tag_size) const {
+  Eigen::Matrix<double, 6, 1> variance = Eigen::Matrix<double, 6, 1>::Zero();
+  switch (kind_) {
+    case TagErrorKind::kOnline:
+      return pose.covariance;
+    case TagErrorKind::kConstant:
+    case TagErrorKind::kQuadratic: {
+      // Eq. 8.1: 1 cm and 1.3 deg; eq. 8.2 scales the variances by (1 + d)^2.
+      variance << 1e-4, 1e-4, 1e-4, 5e-4, 5e-4, 5e-4;
+      if (kind_ == TagErrorKind::kQuadratic) variance *= (1.0 + pose.distance) * (1.0 + pose.distance);
+      break;
+    }
+    case TagErrorKind::kTable:
+    case TagErrorKind::kThesis: {
+      variance = table_->Sigma(pose.distance / camera_scale_, pose.view_angle, tag_size).cwiseAbs2();
+      if (kind_ == TagErrorKind::kThesis) variance = variance.cwiseMax(pose.covariance.diagonal());
+      break;
+    }
+    case TagErrorKind::kCombined: {
+      Matrix6d c = spread_scale_ * pose.sample_covariance;
+      const Eigen::Matrix<double, 6, 1> floor = table_->Sigma(pose.distance / camera_scale_, pose.view_angle, tag_size).cwiseAbs2();
+      for (int k = 0; k < 6; ++k) c(k, k) = std::max(c(k, k), floor[k]);
+      if (pose.has_alternative && table_->corner_rms() > 0.0) {
+        // IPPE's other minimum as the second component of a mixture, weighted by how well each
+        // explains the corners (4 corners' squared distances, noise corner_rms per coordinate):
+        // the moment-matched Gaussian of the two spans both where they compete and is the plain
+        // one where they do not.
+        const double sigma2 = table_->corner_rms() * table_->corner_rms();
+        const double log_ratio = -2.0 * (pose.alternative_reprojection_error * pose.alternative_reprojection_error -
+                                         pose.reprojection_error * pose.reprojection_error) / sigma2;
+        const double p = 1.0 / (1.0 + std::exp(-std::clamp(log_ratio, -50.0, 50.0)));
+        const Eigen::Matrix<double, 6, 1> delta = TagPoseEstimator::Deviation(pose.T_cam_tag, pose.T_cam_tag_alternative);
+        c += p * (1.0 - p) * delta * delta.transpose();
+      }
+      return c;
+    }
+  }
+  return variance.asDiagonal();
+}
+
+}  // namespace cairn
