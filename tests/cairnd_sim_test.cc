@@ -83,6 +83,21 @@ TEST(CairndSimTest, WrongSetupsAreRefusedNamingTheKey) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("submarine"), std::string::npos) << r.output;
 
+  // Region scans between whole-frame scans that do not fall on them; an error table of another
+  // camera.
+  args = SimArgs("rover", out + "/d");
+  args.insert(args.end(), {"--set", "detection.roi_every_nth_frame=3"});
+  r = RunProcess(args);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("detection.roi_every_nth_frame (3) must divide detection.every_nth_frame (2)"),
+            std::string::npos)
+      << r.output;
+  args = SimArgs("rover", out + "/e");
+  args.insert(args.end(), {"--set", "detection.error_table=detection/hexacopter.lut"});
+  r = RunProcess(args);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("hexacopter.lut was built for a 666 px wide camera"), std::string::npos) << r.output;
+
   r = RunProcess({Cairnd(), "--config", Config("rover"), "--sim", "--replay", "/tmp"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("exclude each other"), std::string::npos) << r.output;

@@ -32,17 +32,18 @@ constexpr int kTagId = 0;
 constexpr const char* kBuildUsage =
     "usage: cairn detect build-lut --camera rover|hexacopter --out FILE [--tag-size M (0.16)]\n"
     "                              [--distances FIRST,LAST,COUNT] [--angles FIRST,LAST,COUNT (deg)]\n"
-    "                              [--samples N (16)] [--seed S (1)]\n"
+    "                              [--samples N (16)] [--seed S (1)] [--decimate F (2)]\n"
     "  Renders a tag at every distance and viewing angle of the grid (N times, random in-plane turn,\n"
     "  tilt axis and place in the image) with the simulator's camera, detects it as the daemon does\n"
     "  and writes the RMS pose error per cell (detection/tag_error_table.h).\n";
 
 constexpr const char* kCheckUsage =
     "usage: cairn detect check-lut TABLE [--samples N (400)] [--seed S (2)] [--max-distance M (12)]\n"
-    "                               [--max-angle DEG (60)]\n"
+    "                               [--max-angle DEG (60)] [--decimate F (2)]\n"
     "  Renders N tags at random distances (up to 1.5x the table's last) and angles (0-80 deg) with\n"
     "  the table's camera, and prints per error model the NEES of the detected poses against the\n"
-    "  truth, and how many tags were found, overall and within the distance and angle given.\n";
+    "  truth, and how many tags were found, overall and within the distance and angle given.\n"
+    "  --decimate 1 detects as the daemon's region scans do (2: its whole-frame scans).\n";
 
 struct Camera {
   std::string name;
@@ -150,10 +151,12 @@ bool ParseCount(const std::string& s, double lo, double hi, double* out) {
   return true;
 }
 
-// The detector as the daemon runs it (detection.detector's defaults), for this one id.
-TagDetectorOptions DaemonDetector() {
+// The detector as the daemon runs it (detection.detector's defaults; region scans use decimate
+// 1), for this one id.
+TagDetectorOptions DaemonDetector(double decimate) {
   TagDetectorOptions o;
   o.ids = {static_cast<double>(kTagId)};
+  o.decimate = decimate;
   return o;
 }
 
@@ -161,7 +164,7 @@ TagDetectorOptions DaemonDetector() {
 
 int RunDetectBuildLut(const CommandArgs& args) {
   std::string camera_name, out;
-  double tag_size = 0.16, samples = 16, seed = 1;
+  double tag_size = 0.16, samples = 16, seed = 1, decimate = 2.0;
   double d0 = 0.5, d1 = 24.0, a0 = 0.0, a1 = 80.0;
   int nd = 48, na = 17;
   for (size_t i = 0; i < args.args.size(); ++i) {
@@ -181,6 +184,8 @@ int RunDetectBuildLut(const CommandArgs& args) {
       ok = ParseCount(args.args[++i], 1, 10000, &samples);
     } else if (a == "--seed" && has) {
       ok = ParseCount(args.args[++i], 0, 1e15, &seed);
+    } else if (a == "--decimate" && has) {
+      ok = ParseCount(args.args[++i], 1.0, 8.0, &decimate);
     } else if (a == "--distances" && has) {
       ok = ParseTriple(args.args[++i], &d0, &d1, &nd) && d0 > 0.0;
     } else if (a == "--angles" && has) {
@@ -206,7 +211,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
   }
   const PinholeRadTan& k = camera->intrinsics;
   const sim::TagViewRenderer renderer(terrain, k);
-  TagDetector detector(DaemonDetector());
+  TagDetector detector(DaemonDetector(decimate));
   TagErrorTable table(camera_name, k.width, k.height, k.fx, k.fy, tag_size, d0, d1, nd, a0 * kDeg, a1 * kDeg, na);
   std::mt19937_64 rng(static_cast<uint64_t>(seed));
   double corner_sq = 0.0;
@@ -248,7 +253,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
 
 int RunDetectCheckLut(const CommandArgs& args) {
   std::string path;
-  double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0;
+  double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 2.0;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has = i + 1 < args.args.size();
@@ -264,6 +269,8 @@ int RunDetectCheckLut(const CommandArgs& args) {
       ok = ParseCount(args.args[++i], 0.01, 1000, &max_distance);
     } else if (a == "--max-angle" && has) {
       ok = ParseCount(args.args[++i], 0, 89.9, &max_angle);
+    } else if (a == "--decimate" && has) {
+      ok = ParseCount(args.args[++i], 1.0, 8.0, &decimate);
     } else if (!a.empty() && a[0] != '-' && path.empty()) {
       path = a;
     } else {
@@ -293,7 +300,7 @@ int RunDetectCheckLut(const CommandArgs& args) {
   }
   const PinholeRadTan& k = camera->intrinsics;
   const sim::TagViewRenderer renderer(terrain, k);
-  TagDetector detector(DaemonDetector());
+  TagDetector detector(DaemonDetector(decimate));
   const double last = table->distance_at(table->distance_count() - 1);
   const double tag_size = table->tag_size();
 
@@ -329,7 +336,7 @@ int RunDetectCheckLut(const CommandArgs& args) {
   j.BeginObject();
   j.Field("table", path).Field("camera", table->camera()).Field("seed", static_cast<int64_t>(seed));
   j.Field("rendered", rendered).Field("detected", detected).Field("flipped_best_solutions", flips);
-  j.Field("max_distance_m", max_distance).Field("max_angle_deg", max_angle);
+  j.Field("max_distance_m", max_distance).Field("max_angle_deg", max_angle).Field("decimate", decimate);
   j.Field("in_range", in_range).Field("in_range_detected", in_range_detected);
   j.Field("recall_in_range", in_range > 0 ? static_cast<double>(in_range_detected) / in_range : 0.0);
   // 95 % band of the mean of n chi-square(6) values, by the Wilson-Hilferty approximation.

@@ -102,12 +102,17 @@ Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrie
   if (!graph_) return FailedPreconditionError("robot detection needs the graph enabled");
   if (table.empty()) return InvalidArgumentError("robot detection: the tag carrier table lists no tag");
   if (Status s = options.detector.Validate(); !s.ok()) return s.WithContext("detection.detector");
+  if (options.every_nth_frame % options.roi_every_nth_frame != 0)
+    return InvalidArgumentError("detection.roi_every_nth_frame (" + std::to_string(options.roi_every_nth_frame) +
+                                ") must divide detection.every_nth_frame (" + std::to_string(options.every_nth_frame) + ")");
   auto model = RobotDetectionStage::MakeErrorModel(options, error_table_path, rectify_->camera());
   if (!model.ok()) return model.status();
   graph_->SetLandmarks(table.Landmarks());
   detection_ = std::make_unique<RobotDetectionStage>(options, std::move(table), std::move(*model), rectify_->camera(),
                                                      rectify_->T_body_cam(), robot, graph_->robot());
-  detection_every_ = options.every_nth_frame;
+  // Whole-frame scans on every every_nth_frame-th frame, region scans on every
+  // roi_every_nth_frame-th: the stage gets the latter and counts the former among them.
+  detection_every_ = options.roi_every_nth_frame;
   return Status::Ok();
 }
 
@@ -698,7 +703,10 @@ std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
     out.push_back(r("mapping", mapping_->map_time()));
   }
   if (graph_) out.push_back(r("graph_update", graph_->update_time()));
-  if (detection_) out.push_back(r("tag_detection", detection_->time()));
+  if (detection_) {
+    out.push_back(r("tag_detection", detection_->time()));
+    out.push_back(r("tag_detection_regions", detection_->region_time()));
+  }
   return out;
 }
 

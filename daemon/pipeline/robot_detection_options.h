@@ -14,6 +14,14 @@ namespace cairn {
 struct RobotDetectionOptions {
   bool enabled = false;
   int64_t every_nth_frame = 2;  // of the camera's frames: a whole-frame scan of each
+  // Between whole-frame scans, every `roi_every_nth_frame`-th frame is searched only in regions
+  // around the tags seen in the last `track_timeout` seconds, at `roi_decimate` (full resolution
+  // by default: farther than the whole-frame scan reaches). Must divide every_nth_frame.
+  int64_t roi_every_nth_frame = 1;
+  double roi_decimate = 1.0;
+  double roi_margin = 0.5;      // of the tag's extent in the image, added on every side
+  double roi_margin_px = 32.0;  // px, added on every side as well (the robots' motion in a frame)
+  double track_timeout = 1.0;   // s
   // Which tag is on which robot or landmark (detection/tag_carrier_table.h); "" with `source: sim`
   // takes the simulated world's.
   std::string carriers_file;
@@ -35,6 +43,11 @@ struct RobotDetectionOptions {
   void Visit(OptionsVisitor& v) {
     v.Flag("enabled", enabled);
     v.Integer("every_nth_frame", every_nth_frame, 1, 1000, "frames");
+    v.Integer("roi_every_nth_frame", roi_every_nth_frame, 1, 1000, "frames");
+    v.Number("roi_decimate", roi_decimate, 1.0, 8.0, "");
+    v.Number("roi_margin", roi_margin, 0.0, 10.0, "tag extents");
+    v.Number("roi_margin_px", roi_margin_px, 0.0, 1000.0, "px");
+    v.Number("track_timeout", track_timeout, 0.0, 60.0, "s");
     v.Text("carriers_file", carriers_file);
     v.Number("corner_error", corner_error, 0.0, 10.0, "px");
     v.Text("error_model", error_model);

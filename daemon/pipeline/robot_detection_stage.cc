@@ -1,5 +1,6 @@
 #include "daemon/pipeline/robot_detection_stage.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/monotonic_clock.h"
@@ -61,7 +62,14 @@ RobotDetectionStage::RobotDetectionStage(const RobotDetectionOptions& options, T
         TagDetectorOptions o = options.detector;
         if (o.ids.empty()) o.ids = table_.Ids();  // the rest are counted as unknown
         return o;
-      }()) {
+      }()),
+      region_detector_([&] {
+        TagDetectorOptions o = options.detector;
+        if (o.ids.empty()) o.ids = table_.Ids();
+        o.decimate = options.roi_decimate;
+        return o;
+      }()),
+      full_every_(std::max<int64_t>(1, options.every_nth_frame / std::max<int64_t>(1, options.roi_every_nth_frame))) {
   camera_.width = camera.width;
   camera_.height = camera.height;
   camera_.fx = camera_.fy = camera.f;
@@ -81,13 +89,61 @@ Matrix6d RobotDetectionStage::CarrierCovariance(const Matrix6d& tag_covariance, 
   return 0.5 * (c + c.transpose());
 }
 
+PixelBox RobotDetectionStage::Region(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int width, int height,
+                                     double margin, double margin_px) {
+  const double extent = std::max(hi.x() - lo.x(), hi.y() - lo.y());
+  const double m = margin * extent + margin_px;
+  const int x0 = std::max(0, static_cast<int>(std::floor(lo.x() - m)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(lo.y() - m)));
+  const int x1 = std::min(width - 1, static_cast<int>(std::ceil(hi.x() + m)));
+  const int y1 = std::min(height - 1, static_cast<int>(std::ceil(hi.y() + m)));
+  if (x0 > x1 || y0 > y1) return PixelBox{};
+  return PixelBox{x0, y0, x1 - x0 + 1, y1 - y0 + 1};
+}
+
+Expected<std::vector<TagDetection>> RobotDetectionStage::Find(const RectifiedPair& pair, bool full) {
+  if (full) {
+    ++report_.full_scans;
+    return detector_.Detect(pair.left);
+  }
+  ++report_.region_scans;
+  std::vector<TagDetection> all;
+  for (const auto& [id, track] : tracks_) {
+    const PixelBox box = Region(track.lo, track.hi, pair.left.width, pair.left.height, options_.roi_margin,
+                                options_.roi_margin_px);
+    if (box.width <= 0) continue;
+    ++report_.regions;
+    auto found = region_detector_.Detect(pair.left, &box);
+    if (!found.ok()) return found.status();
+    for (TagDetection& d : *found) {
+      // Regions of tags close together overlap: each tag once.
+      const bool seen = std::any_of(all.begin(), all.end(), [&](const TagDetection& a) { return a.id == d.id; });
+      if (!seen) all.push_back(std::move(d));
+    }
+  }
+  report_.tags_in_regions += all.size();
+  return all;
+}
+
 void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSighting>* out) {
   const MonotonicClock clock;
   const Timestamp start = clock.Now();
   ++report_.images;
-  const uint64_t unknown_before = detector_.counts().unknown_ids;
-  auto found = detector_.Detect(pair.left);
-  report_.unknown_ids += detector_.counts().unknown_ids - unknown_before;
+  const bool full = frames_++ % static_cast<uint64_t>(full_every_) == 0;
+  // Tags not seen for a while are searched for by the whole-frame scans only (time going back:
+  // another recording).
+  for (auto it = tracks_.begin(); it != tracks_.end();) {
+    const double age = (pair.time - it->second.seen).seconds();
+    it = (age > options_.track_timeout || age < 0.0) ? tracks_.erase(it) : std::next(it);
+  }
+  if (!full && tracks_.empty()) {
+    ++report_.idle;
+    return;
+  }
+  const auto unknown = [&] { return detector_.counts().unknown_ids + region_detector_.counts().unknown_ids; };
+  const uint64_t unknown_before = unknown();
+  auto found = Find(pair, full);
+  report_.unknown_ids += unknown() - unknown_before;
   if (!found.ok()) {
     ++report_.bad_images;
     if (report_.errors.size() < kMaxErrors) report_.errors.push_back(found.status().ToString());
@@ -105,6 +161,13 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
       continue;
     }
     ++report_.tags;
+    Track& track = tracks_[d.id];
+    track.lo = track.hi = d.corners[0];
+    for (const Eigen::Vector2d& c : d.corners) {
+      track.lo = track.lo.cwiseMin(c);
+      track.hi = track.hi.cwiseMax(c);
+    }
+    track.seen = pair.time;
     TagPoseOptions po;
     po.tag_size = mount->size;
     po.corner_error = options_.corner_error;
@@ -149,7 +212,9 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
     ++(s.usable ? report_.usable : report_.refused);
     out->push_back(std::move(s));
   }
-  time_.Record(clock.Now() - start);
+  const auto took = clock.Now() - start;
+  time_.Record(took);
+  if (!full) region_time_.Record(took);
 }
 
 }  // namespace cairn

@@ -1,12 +1,14 @@
 #pragma once
 // The detection executor's work: tags on the left rectified image (a whole-frame scan of every
-// `every_nth_frame`-th pair), each tag's pose by IPPE with the configured error model
+// `every_nth_frame`-th pair; on the pairs between, regions around the tags seen lately, the fast
+// path of thesis 6.2.1), each tag's pose by IPPE with the configured error model
 // (detection/tag_error_model.h), and from the
 // carrier table the observed robot's or landmark's body in this robot's body at the exposure time.
 // Tags of this robot itself and ids not in the table are counted and dropped; sightings beyond
 // the configured distance or uncertainty are handed on marked as refused, with the reason.
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,7 +33,12 @@ struct TagSighting {
 };
 
 struct RobotDetectionReport {
-  uint64_t images = 0;
+  uint64_t images = 0;          // handed to the stage
+  uint64_t full_scans = 0;      // whole-frame scans
+  uint64_t region_scans = 0;    // images searched in regions around tracked tags
+  uint64_t regions = 0;         // regions searched
+  uint64_t idle = 0;            // images between whole-frame scans with no tag to track
+  uint64_t tags_in_regions = 0;  // tags found by region scans
   uint64_t bad_images = 0;
   uint64_t tags = 0;            // decoded tags of the table's ids
   uint64_t own_tags = 0;        // this robot's own (seen in a mirror or through a gap)
@@ -53,11 +60,19 @@ class RobotDetectionStage {
   static Expected<TagErrorModel> MakeErrorModel(const RobotDetectionOptions& options, const std::string& table_path,
                                                 const RectifiedStereoCamera& camera);
 
-  // Appends a sighting for every tag of another carrier in the pair's left image.
+  // Appends a sighting for every tag of another carrier in the pair's left image. Call with every
+  // `roi_every_nth_frame`-th pair: each (every_nth_frame / roi_every_nth_frame)-th, starting with
+  // the first, is scanned whole.
   void Process(const RectifiedPair& pair, std::vector<TagSighting>* out);
+
+  // A tag's corners' bounding box grown by the configured margins and clipped to the image; empty
+  // (width 0) when nothing of it is inside.
+  static PixelBox Region(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, int width, int height,
+                         double margin, double margin_px);
 
   const RobotDetectionReport& report() const { return report_; }
   const LatencyHistogram& time() const { return time_; }
+  const LatencyHistogram& region_time() const { return region_time_; }
 
   // The covariance of a tag pose (the estimator's tangent at T_cam_tag) as the covariance of
   // T_cam_tag * T_tag_carrier in the same kind of tangent (translation in the carrier's axes).
@@ -71,9 +86,22 @@ class RobotDetectionStage {
   Eigen::Isometry3d T_body_cam_;
   std::string robot_;
   char letter_ = 0;
+  // Where each tracked tag (an id of another carrier) was last seen.
+  struct Track {
+    Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = Eigen::Vector2d::Zero();
+    Timestamp seen;
+  };
+  // Tags to search for in this image: a whole-frame scan, or regions around the tracks.
+  Expected<std::vector<TagDetection>> Find(const RectifiedPair& pair, bool full);
+
   TagDetector detector_;
+  TagDetector region_detector_;
+  std::map<int, Track> tracks_;
+  uint64_t frames_ = 0;
+  int64_t full_every_ = 1;  // of the frames handed in
   RobotDetectionReport report_;
-  LatencyHistogram time_;
+  LatencyHistogram time_;         // every image
+  LatencyHistogram region_time_;  // images searched in regions only
 };
 
 }  // namespace cairn

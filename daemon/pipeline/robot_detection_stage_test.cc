@@ -62,6 +62,7 @@ RobotDetectionOptions Options() {
   o.enabled = true;
   o.detector.decimate = 1.0;
   o.max_sigma_rotation = 3.0;  // a small tag's tilt is poorly known (eq. 6.9): kept, with its sigma
+  o.roi_every_nth_frame = o.every_nth_frame;  // every image scanned whole (regions: their own test)
   return o;
 }
 
@@ -175,6 +176,65 @@ TEST(RobotDetectionStageTest, AnErrorTableOfAnotherCameraOrAMissingOneIsRefusedA
   m = RobotDetectionStage::MakeErrorModel(o, "", Camera());
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.status().message().find("detection.error_model"), std::string::npos) << m.status().message();
+}
+
+// Between whole-frame scans (decimate 2, every 4th frame) the stage searches only around the tags
+// it saw lately, at full resolution: it follows a teammate's tag to where the whole-frame scan
+// no longer finds it, and stops looking once the tag has been gone for the track timeout.
+TEST(RobotDetectionStageTest, RegionScansFollowATagBetweenWholeFrameScans) {
+  RobotDetectionOptions o = Options();
+  o.detector.decimate = 2.0;
+  o.every_nth_frame = 4;
+  o.roi_every_nth_frame = 1;  // every 4th frame whole, the 3 between in regions
+  o.track_timeout = 1.0;
+  o.max_distance = 20.0;
+  RobotDetectionStage stage(o, Table(), ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  std::vector<TagSighting> out;
+  const auto at = [&](double distance) {
+    Eigen::Isometry3d T = TagInView(distance, 10 * kDeg);
+    T.translation().head<2>() *= distance / 3.0;  // the same place in the image
+    return T;
+  };
+  stage.Process(PairOf(testing::RenderTag(10, 0.16, at(4.0), Pinhole()), 0), &out);  // whole
+  ASSERT_EQ(out.size(), 1u);
+  const cv::Mat far = testing::RenderTag(10, 0.16, at(11.0), Pinhole());
+  out.clear();
+  stage.Process(PairOf(testing::RenderTag(10, 0.16, at(6.0), Pinhole()), 100'000'000), &out);  // region
+  stage.Process(PairOf(far, 200'000'000), &out);                                                // region
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NEAR(out[1].detection.distance, 11.0, 0.5);
+  // The whole-frame scan at decimate 2 does not find the tag at 11 m.
+  TagDetectorOptions whole = o.detector;
+  EXPECT_TRUE(TagDetector(whole).Detect(testing::ImageOf(far))->empty());
+  EXPECT_EQ(stage.report().full_scans, 1u);
+  EXPECT_EQ(stage.report().region_scans, 2u);
+  EXPECT_EQ(stage.report().tags_in_regions, 2u);
+  // Gone: region scans find nothing until the track times out, then the frames between whole
+  // scans cost nothing.
+  const cv::Mat empty(508, 1024, CV_8UC1, cv::Scalar(128));
+  out.clear();
+  stage.Process(PairOf(empty, 300'000'000), &out);    // region, nothing
+  stage.Process(PairOf(empty, 400'000'000), &out);    // whole, nothing
+  stage.Process(PairOf(empty, 1'500'000'000), &out);  // region: the track has timed out
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(stage.report().full_scans, 2u);
+  EXPECT_EQ(stage.report().region_scans, 3u);
+  EXPECT_EQ(stage.report().idle, 1u);
+  EXPECT_GT(stage.region_time().count(), 0u);
+}
+
+TEST(RobotDetectionStageTest, RegionsGrowByTheMarginsAndStayInsideTheImage) {
+  PixelBox b = RobotDetectionStage::Region({100, 50}, {140, 70}, 1024, 508, 0.5, 10);  // extent 40: 30 px
+  EXPECT_EQ(b.x, 70);
+  EXPECT_EQ(b.y, 20);
+  EXPECT_EQ(b.width, 101);
+  EXPECT_EQ(b.height, 81);
+  b = RobotDetectionStage::Region({-50, -50}, {10, 10}, 1024, 508, 0.0, 5);
+  EXPECT_EQ(b.x, 0);
+  EXPECT_EQ(b.y, 0);
+  EXPECT_EQ(b.width, 16);
+  b = RobotDetectionStage::Region({2000, 10}, {2100, 20}, 1024, 508, 0.0, 5);
+  EXPECT_EQ(b.width, 0);
 }
 
 TEST(RobotDetectionStageTest, BadImagesAreCountedNotFatal) {
