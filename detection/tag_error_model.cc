@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cairn {
 namespace {
@@ -44,6 +45,12 @@ Expected<TagErrorModel> TagErrorModel::Create(TagErrorKind kind, std::shared_ptr
     return InvalidArgumentError("tag error model: camera scale " + std::to_string(camera_scale) + " is not in (0, 1]");
   const double ratio = kind == TagErrorKind::kCombined ? table->corner_rms() / corner_error : 1.0;
   return TagErrorModel(kind, std::move(table), ratio * ratio, camera_scale);
+}
+
+double TagErrorModel::ResidualChi2(const TagPose& pose) const {
+  if (table_ == nullptr || !(table_->corner_rms() > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  // reprojection_error is the RMS over the 4 corners of their distance to the projection.
+  return 4.0 * pose.reprojection_error * pose.reprojection_error / (table_->corner_rms() * table_->corner_rms());
 }
 
 Matrix6d TagErrorModel::Covariance(const TagPose& pose, double tag_size) const {

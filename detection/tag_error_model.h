@@ -45,6 +45,12 @@ class TagErrorModel {
   // kind but kTable, kConstant and kQuadratic needs the online spread in `pose` (sample_corners on).
   Matrix6d Covariance(const TagPose& pose, double tag_size) const;
 
+  // How far the corners are from the projection of a square at the pose, against the table's
+  // corner error: chi-square with 2 degrees of freedom (8 coordinates, 6 pose parameters). A
+  // detection far out (corners of a wrong quad, seen too obliquely) has no pose to trust. NaN
+  // without a table.
+  double ResidualChi2(const TagPose& pose) const;
+
   TagErrorKind kind() const { return kind_; }
   const TagErrorTable* table() const { return table_.get(); }
 

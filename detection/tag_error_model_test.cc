@@ -1,5 +1,6 @@
 #include "detection/tag_error_model.h"
 
+#include <cmath>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -97,6 +98,15 @@ TEST(TagErrorModelTest, CompetingMinimaWidenTheCombinedCovarianceAlongTheirDiffe
   // The other explains them far worse (1 px against 0.1 px at 0.25 px noise): nothing added.
   pose.alternative_reprojection_error = 1.0;
   EXPECT_NEAR(model->Covariance(pose, 0.16)(3, 3), 1e-4, 1e-9);
+}
+
+TEST(TagErrorModelTest, TheResidualIsChiSquareAgainstTheTablesCornerError) {
+  TagPose pose;
+  pose.reprojection_error = 0.25;  // px RMS over the corners, the table's corner error
+  EXPECT_NEAR(TagErrorModel::Create(TagErrorKind::kCombined, FlatTable(0.01))->ResidualChi2(pose), 4.0, 1e-12);
+  pose.reprojection_error = 0.65;
+  EXPECT_GT(TagErrorModel::Create(TagErrorKind::kTable, FlatTable(0.01))->ResidualChi2(pose), 13.8);
+  EXPECT_TRUE(std::isnan(TagErrorModel::Create(TagErrorKind::kOnline, nullptr)->ResidualChi2(pose)));
 }
 
 }  // namespace

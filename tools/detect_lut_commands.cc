@@ -39,11 +39,13 @@ constexpr const char* kBuildUsage =
 
 constexpr const char* kCheckUsage =
     "usage: cairn detect check-lut TABLE [--samples N (400)] [--seed S (2)] [--max-distance M (12)]\n"
-    "                               [--max-angle DEG (60)] [--decimate F (2)]\n"
+    "                               [--max-angle DEG (60)] [--decimate F (2)] [--max-residual-chi2 X (13.8)]\n"
     "  Renders N tags at random distances (up to 1.5x the table's last) and angles (0-80 deg) with\n"
     "  the table's camera, and prints per error model the NEES of the detected poses against the\n"
     "  truth, and how many tags were found, overall and within the distance and angle given.\n"
-    "  --decimate 1 detects as the daemon's region scans do (2: its whole-frame scans).\n";
+    "  --decimate 1 detects as the daemon's region scans do (2: its whole-frame scans). Detections\n"
+    "  whose corners are farther from a square's projection than the chi-square bound are left out\n"
+    "  of the NEES, as the daemon refuses them.\n";
 
 struct Camera {
   std::string name;
@@ -253,7 +255,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
 
 int RunDetectCheckLut(const CommandArgs& args) {
   std::string path;
-  double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 2.0;
+  double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 2.0, max_residual_chi2 = 13.8;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has = i + 1 < args.args.size();
@@ -271,6 +273,8 @@ int RunDetectCheckLut(const CommandArgs& args) {
       ok = ParseCount(args.args[++i], 0, 89.9, &max_angle);
     } else if (a == "--decimate" && has) {
       ok = ParseCount(args.args[++i], 1.0, 8.0, &decimate);
+    } else if (a == "--max-residual-chi2" && has) {
+      ok = ParseCount(args.args[++i], 0.0, 1e9, &max_residual_chi2);
     } else if (!a.empty() && a[0] != '-' && path.empty()) {
       path = a;
     } else {
@@ -314,7 +318,7 @@ int RunDetectCheckLut(const CommandArgs& args) {
   for (const TagErrorKind kind : kinds) models.push_back(*TagErrorModel::Create(kind, table, TagPoseOptions{}.corner_error));
   std::mt19937_64 rng(static_cast<uint64_t>(seed));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  int rendered = 0, detected = 0, in_range = 0, in_range_detected = 0, flips = 0;
+  int rendered = 0, detected = 0, in_range = 0, in_range_detected = 0, flips = 0, refused_residual = 0;
   for (int s = 0; s < static_cast<int>(samples); ++s) {
     const double d = table->distance_at(0) + unit(rng) * (1.5 * last - table->distance_at(0));
     const double angle = unit(rng) * 80.0 * kDeg;
@@ -326,6 +330,11 @@ int RunDetectCheckLut(const CommandArgs& args) {
     if (!si.detected) continue;
     ++detected;
     in_range_detected += inside;
+    // The daemon refuses these (detection.max_residual_chi2).
+    if (models[0].ResidualChi2(si.pose) > max_residual_chi2) {
+      ++refused_residual;
+      continue;
+    }
     flips += si.error.tail<3>().norm() > si.nearest_error.tail<3>().norm() + 1e-9;
     for (size_t m = 0; m < models.size(); ++m) {
       const Matrix6d P = models[m].Covariance(si.pose, tag_size);
@@ -336,6 +345,7 @@ int RunDetectCheckLut(const CommandArgs& args) {
   j.BeginObject();
   j.Field("table", path).Field("camera", table->camera()).Field("seed", static_cast<int64_t>(seed));
   j.Field("rendered", rendered).Field("detected", detected).Field("flipped_best_solutions", flips);
+  j.Field("refused_residual", refused_residual).Field("max_residual_chi2", max_residual_chi2);
   j.Field("max_distance_m", max_distance).Field("max_angle_deg", max_angle).Field("decimate", decimate);
   j.Field("in_range", in_range).Field("in_range_detected", in_range_detected);
   j.Field("recall_in_range", in_range > 0 ? static_cast<double>(in_range_detected) / in_range : 0.0);

@@ -37,6 +37,9 @@ struct RobotDetectionOptions {
   double max_distance = 12.0;          // m, camera to tag
   double max_sigma_translation = 0.3;  // m, largest translation sigma of the tag's pose
   double max_sigma_rotation = 1.0;     // rad, largest rotation sigma
+  // Corners this far from a square's projection (chi-square, 2 degrees of freedom, against the
+  // error table's corner error; 13.8 is its 99.9 % point) give no pose to trust.
+  double max_residual_chi2 = 13.8;
   bool write_csv = true;               // OUT/detections.csv
   TagDetectorOptions detector;
 
@@ -55,6 +58,7 @@ struct RobotDetectionOptions {
     v.Number("max_distance", max_distance, 0.1, 1000.0, "m");
     v.Number("max_sigma_translation", max_sigma_translation, 1e-4, 100.0, "m");
     v.Number("max_sigma_rotation", max_sigma_rotation, 1e-4, 3.2, "rad");
+    v.Number("max_residual_chi2", max_residual_chi2, 0.0, 1e9, "chi-square");
     v.Flag("write_csv", write_csv);
     v.Section("detector", detector);
   }

@@ -199,8 +199,12 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
       sigma_t = std::max(sigma_t, std::sqrt(std::max(0.0, tag_covariance(i, i))));
       sigma_r = std::max(sigma_r, std::sqrt(std::max(0.0, tag_covariance(i + 3, i + 3))));
     }
+    const double residual = error_model_.ResidualChi2(*pose);
     if (pose->distance > options_.max_distance) {
       s.refused = "farther than " + Fixed(options_.max_distance, 1) + " m";
+    } else if (residual > options_.max_residual_chi2) {
+      s.refused = "corners off a square's projection (" + Fixed(pose->reprojection_error, 2) + " px, chi-square " +
+                  Fixed(residual, 1) + " above the bound)";
     } else if (sigma_t > options_.max_sigma_translation) {
       s.refused = "translation sigma " + Fixed(sigma_t, 3) + " m above the bound";
     } else if (sigma_r > options_.max_sigma_rotation) {
