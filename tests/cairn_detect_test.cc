@@ -74,6 +74,9 @@ TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
   r = Detect({"build-lut", "--camera", "drone", "--out", table});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--camera must be rover or hexacopter, not 'drone'"), std::string::npos) << r.output;
+  r = Detect({"build-lut", "--camera", "mine", "--intrinsics", "640,480,0,500", "--out", table});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("--intrinsics needs W,H,FX,FY"), std::string::npos) << r.output;
   r = Detect({"build-lut", "--camera", "rover", "--out", table, "--distances", "4,1,3"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--distances: bad value"), std::string::npos) << r.output;

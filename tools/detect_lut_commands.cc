@@ -30,12 +30,15 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr int kTagId = 0;
 
 constexpr const char* kBuildUsage =
-    "usage: cairn detect build-lut --camera rover|hexacopter --out FILE [--tag-size M (0.16)]\n"
-    "                              [--distances FIRST,LAST,COUNT] [--angles FIRST,LAST,COUNT (deg)]\n"
-    "                              [--samples N (16)] [--seed S (1)] [--decimate F (2)]\n"
+    "usage: cairn detect build-lut --camera rover|hexacopter|NAME [--intrinsics W,H,FX,FY] --out FILE\n"
+    "                              [--tag-size M (0.16)] [--distances FIRST,LAST,COUNT]\n"
+    "                              [--angles FIRST,LAST,COUNT (deg)] [--samples N (16)] [--seed S (1)]\n"
+    "                              [--decimate F (2)]\n"
     "  Renders a tag at every distance and viewing angle of the grid (N times, random in-plane turn,\n"
-    "  tilt axis and place in the image) with the simulator's camera, detects it as the daemon does\n"
-    "  and writes the RMS pose error per cell (detection/tag_error_table.h).\n";
+    "  tilt axis and place in the image) with the simulator's camera model, detects it as the daemon\n"
+    "  does and writes the RMS pose error per cell (detection/tag_error_table.h). The camera is a\n"
+    "  simulated robot's, or any rectified camera given by --intrinsics (image size and focal\n"
+    "  lengths in px; the principal point at the image's centre).\n";
 
 constexpr const char* kCheckUsage =
     "usage: cairn detect check-lut TABLE [--samples N (400)] [--seed S (2)] [--max-distance M (12)]\n"
@@ -52,14 +55,29 @@ struct Camera {
   PinholeRadTan intrinsics;
 };
 
-Expected<Camera> CameraPreset(const std::string& name, const sim::Terrain& terrain) {
+// A simulated robot's rectified left camera, or one of the given size and focal lengths with its
+// principal point at the centre (as the simulator's, so a table's header gives its camera back).
+Expected<Camera> CameraOf(const std::string& name, const std::vector<double>& intrinsics, const sim::Terrain& terrain) {
+  if (!intrinsics.empty()) {
+    if (intrinsics.size() != 4 || !(intrinsics[0] >= 16 && intrinsics[1] >= 16 && intrinsics[2] > 0 && intrinsics[3] > 0) ||
+        intrinsics[0] != std::floor(intrinsics[0]) || intrinsics[1] != std::floor(intrinsics[1]))
+      return InvalidArgumentError("--intrinsics needs W,H,FX,FY: whole image sizes >= 16 px and focal lengths > 0");
+    PinholeRadTan k;
+    k.width = static_cast<int>(intrinsics[0]);
+    k.height = static_cast<int>(intrinsics[1]);
+    k.fx = intrinsics[2];
+    k.fy = intrinsics[3];
+    k.cx = (k.width - 1) / 2.0;
+    k.cy = (k.height - 1) / 2.0;
+    return Camera{name, k};
+  }
   sim::SimRobot robot;
   if (name == "rover") {
     robot = sim::MakeRover(terrain, "rover", 0, 1, 10.0, 1.0, 0.16);
   } else if (name == "hexacopter") {
     robot = sim::MakeHexacopter(terrain, "hexacopter", 0, 1, 10.0, 1.0, 0.16);
   } else {
-    return InvalidArgumentError("--camera must be rover or hexacopter, not '" + name + "'");
+    return InvalidArgumentError("--camera must be rover or hexacopter, not '" + name + "' (or give --intrinsics)");
   }
   return Camera{name, robot.stereo.left.intrinsics};
 }
@@ -166,6 +184,7 @@ TagDetectorOptions DaemonDetector(double decimate) {
 
 int RunDetectBuildLut(const CommandArgs& args) {
   std::string camera_name, out;
+  std::vector<double> intrinsics;
   double tag_size = 0.16, samples = 16, seed = 1, decimate = 2.0;
   double d0 = 0.5, d1 = 24.0, a0 = 0.0, a1 = 80.0;
   int nd = 48, na = 17;
@@ -180,6 +199,8 @@ int RunDetectBuildLut(const CommandArgs& args) {
       camera_name = args.args[++i];
     } else if (a == "--out" && has) {
       out = args.args[++i];
+    } else if (a == "--intrinsics" && has) {
+      ok = ParseNumberList(args.args[++i], &intrinsics);
     } else if (a == "--tag-size" && has) {
       ok = ParseCount(args.args[++i], 0.01, 10.0, &tag_size);
     } else if (a == "--samples" && has) {
@@ -206,7 +227,11 @@ int RunDetectBuildLut(const CommandArgs& args) {
     return 2;
   }
   const sim::Terrain terrain = sim::Terrain::Generate(sim::WorldOptions{});
-  const auto camera = CameraPreset(camera_name, terrain);
+  if (camera_name.find_first_of(" \t\n#") != std::string::npos) {
+    std::fprintf(stderr, "cairn detect build-lut: --camera '%s': a name without spaces or '#'\n", camera_name.c_str());
+    return 2;
+  }
+  const auto camera = CameraOf(camera_name, intrinsics, terrain);
   if (!camera.ok()) {
     std::fprintf(stderr, "cairn detect build-lut: %s\n", camera.status().message().c_str());
     return 2;
@@ -297,7 +322,9 @@ int RunDetectCheckLut(const CommandArgs& args) {
   }
   const auto table = std::make_shared<const TagErrorTable>(std::move(*loaded));
   const sim::Terrain terrain = sim::Terrain::Generate(sim::WorldOptions{});
-  const auto camera = CameraPreset(table->camera(), terrain);
+  // The table's camera, from its header.
+  const auto camera = CameraOf(table->camera(), {static_cast<double>(table->width()), static_cast<double>(table->height()),
+                                                 table->fx(), table->fy()}, terrain);
   if (!camera.ok()) {
     std::fprintf(stderr, "cairn detect check-lut: %s: %s\n", path.c_str(), camera.status().message().c_str());
     return 1;
