@@ -135,33 +135,30 @@ int RunGraphSolve(const CommandArgs& args) {
     std::fprintf(stderr, "cairn graph solve: %s\n", graph.status().message().c_str());
     return 1;
   }
-  if (const size_t indefinite = graph->indefinite_edges(); indefinite > 0 && project) {
-    for (PoseGraphEdge& e : graph->edges()) {
-      if (!e.definite) ProjectToPositiveDefinite(e);
+  if (const size_t indefinite = graph->indefinite_edges(); indefinite > 0) {
+    // What becomes of them; the geodesic objective without projection is the solver's to refuse.
+    const bool sesync = options.objective == PoseGraphSolverOptions::Objective::kSeSync;
+    if (project) {
+      for (PoseGraphEdge& e : graph->edges()) {
+        if (!e.definite) ProjectToPositiveDefinite(e);
+      }
     }
-    std::fprintf(stderr,
-                 "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s): "
-                 "using the nearest positive-definite matrices\n",
-                 indefinite, graph->edges().size(), graph->first_indefinite().c_str());
-  } else if (indefinite > 0 && options.objective == PoseGraphSolverOptions::Objective::kSeSync) {
-    std::fprintf(stderr,
-                 "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s): "
-                 "the SE-Sync objective uses only their isotropic precisions\n",
-                 indefinite, graph->edges().size(), graph->first_indefinite().c_str());
-  } else if (indefinite > 0) {
-    std::fprintf(stderr,
-                 "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s); "
-                 "the geodesic objective needs it: use --objective sesync (their isotropic precisions) or "
-                 "--project-information (the nearest positive-definite matrices)\n",
-                 indefinite, graph->edges().size(), graph->first_indefinite().c_str());
-    return 1;
+    if (project || sesync) {
+      std::fprintf(stderr, "cairn graph solve: %zu of %zu edges' information is not positive definite (first at %s): %s\n",
+                   indefinite, graph->edges().size(), graph->first_indefinite().c_str(),
+                   project ? "using the nearest positive-definite matrices"
+                           : "the SE-Sync objective uses only their isotropic precisions");
+    }
   }
   // Loop closures before the rest are lost with the edges the solve may drop.
   std::vector<bool> closure(graph->edges().size());
   for (size_t k = 0; k < closure.size(); ++k) closure[k] = IsLoopClosure(graph->edges()[k]);
   auto summary = SolvePoseGraph(*graph, options);
   if (!summary.ok()) {
-    std::fprintf(stderr, "cairn graph solve: %s\n", summary.status().message().c_str());
+    const bool hint = graph->indefinite_edges() > 0 && !project;
+    std::fprintf(stderr, "cairn graph solve: %s%s\n", summary.status().message().c_str(),
+                 hint ? " (--objective sesync, or --project-information for the nearest positive-definite matrices)"
+                      : "");
     return 1;
   }
   std::string outlier_stats;
