@@ -67,6 +67,7 @@ double HitBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::V
 // Albedo of a marker at local (x, y): quiet ring white, border black, 6 x 6 data bits.
 float MarkerAlbedo(const SimMarker& m, double x, double y) {
   const double module = m.size / 8.0, half = 5 * module;
+  if (!(std::abs(x) < half && std::abs(y) < half)) return 0.85f;  // beyond the quiet ring (or NaN)
   const int c = static_cast<int>((x + half) / module), r = static_cast<int>((half - y) / module);
   if (r <= 0 || c <= 0 || r >= 9 || c >= 9) return 0.85f;
   if (r == 1 || c == 1 || r == 8 || c == 8) return 0.04f;
@@ -422,7 +423,13 @@ void CameraRenderer::RenderSignal(const RenderScene& scene, const PinholeRadTan&
                   const double du = (su + 0.5) / kMarkerSamples - 0.5, dv = (sv + 0.5) / kMarkerSamples - 0.5;
                   const Eigen::Vector3d ds = ob.T_obj_world.linear() * world_ray(col_x[static_cast<size_t>(u)] + du / k.fx,
                                                                                  yc + dv / k.fy);
-                  const Eigen::Vector3d ps = o + (-o.z() / std::min(ds.z(), -1e-12)) * ds;
+                  // A sub-ray that does not meet the marker's plane in front (grazing view)
+                  // takes the pixel centre's value.
+                  if (!(ds.z() < -1e-9)) {
+                    sum += MarkerAlbedo(*ob.marker, p.x(), p.y());
+                    continue;
+                  }
+                  const Eigen::Vector3d ps = o + (-o.z() / ds.z()) * ds;
                   sum += MarkerAlbedo(*ob.marker, ps.x(), ps.y());
                 }
               }

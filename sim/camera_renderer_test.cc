@@ -221,3 +221,35 @@ TEST(CameraRendererTest, AMarkerEdgeThroughAPixelGivesItTheCoveredShare) {
 
 }  // namespace
 }  // namespace cairn::sim
+
+namespace cairn::sim {
+namespace {
+
+// A marker seen at a grazing angle (lying flat 4 mm below the camera, 2 m ahead, where row 60's
+// centre ray meets it): some of that pixel's rays point above the horizon and never meet its
+// plane. They must not be followed to infinity (an integer overflow under UBSan).
+TEST(CameraRendererTest, AMarkerSeenAtAGrazingAngleRendersWithoutOverflow) {
+  const Terrain terrain = Terrain::Generate(SmallWorld());
+  PinholeRadTan k;
+  k.width = 160;
+  k.height = 120;
+  k.fx = k.fy = 100.0;
+  k.cx = 79.5;
+  k.cy = 59.8;  // row 60's centre 0.2 px below the horizon, its top rays above
+  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
+  T_world_cam.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // looking along +x, level
+  T_world_cam.translation() = Eigen::Vector3d(0, 0, terrain.Height(0, 0) + 2.0);
+  SimMarker m;
+  m.id = 0;
+  m.size = 0.5;
+  m.T_body_marker.translation() = T_world_cam.translation() + Eigen::Vector3d(2.0, 0.0, -0.004);  // face up
+  RenderScene scene;
+  scene.terrain = &terrain;
+  scene.markers.push_back(m);
+  std::vector<uint8_t> img;
+  CameraRenderer::Render(scene, k, T_world_cam, RenderOptions{}, 1, &img, nullptr);
+  ASSERT_EQ(img.size(), static_cast<size_t>(k.width * k.height));
+}
+
+}  // namespace
+}  // namespace cairn::sim
