@@ -170,26 +170,32 @@ TEST(CameraRendererTest, MarkerFacingTheCameraShowsItsBits) {
   }
 }
 
-}  // namespace
-}  // namespace cairn::sim
+// A camera of `width` x `height` px, focal length `f`, principal point (cx, cy), 2 m above the
+// terrain at the origin, looking level along +x.
+PinholeRadTan Pinhole(int width, int height, double f, double cx, double cy) {
+  PinholeRadTan k;
+  k.width = width;
+  k.height = height;
+  k.fx = k.fy = f;
+  k.cx = cx;
+  k.cy = cy;
+  return k;
+}
 
-namespace cairn::sim {
-namespace {
+Eigen::Isometry3d LevelAlongX(const Terrain& terrain) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  T.translation() = Eigen::Vector3d(0, 0, terrain.Height(0, 0) + 2.0);
+  return T;
+}
 
 // A pixel averages the light over its area: one that a marker's white-to-black edge cuts at a
 // quarter of its width is three quarters white (one ray per pixel would make it all white, and
 // every edge would snap to pixel boundaries).
 TEST(CameraRendererTest, AMarkerEdgeThroughAPixelGivesItTheCoveredShare) {
   const Terrain terrain = Terrain::Generate(SmallWorld());
-  PinholeRadTan k;
-  k.width = 320;
-  k.height = 240;
-  k.fx = k.fy = 200.0;
-  k.cx = 159.5;
-  k.cy = 119.5;
-  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
-  T_world_cam.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // looking along +x
-  T_world_cam.translation() = Eigen::Vector3d(0, 0, terrain.Height(0, 0) + 2.0);
+  const PinholeRadTan k = Pinhole(320, 240, 200.0, 159.5, 119.5);
+  const Eigen::Isometry3d T_world_cam = LevelAlongX(terrain);
   // Face on at 2 m: marker x runs along image u at 100 px/m. The quiet ring ends and the black
   // border starts at x = -4 modules; put that at u = 100.25.
   const double module = (159.5 - 100.25) / 100.0 / 4.0;
@@ -219,26 +225,14 @@ TEST(CameraRendererTest, AMarkerEdgeThroughAPixelGivesItTheCoveredShare) {
   EXPECT_NEAR(at(101), black, 1.0);
 }
 
-}  // namespace
-}  // namespace cairn::sim
-
-namespace cairn::sim {
-namespace {
-
 // A marker seen at a grazing angle (lying flat 4 mm below the camera, 2 m ahead, where row 60's
 // centre ray meets it): some of that pixel's rays point above the horizon and never meet its
 // plane. They must not be followed to infinity (an integer overflow under UBSan).
 TEST(CameraRendererTest, AMarkerSeenAtAGrazingAngleRendersWithoutOverflow) {
   const Terrain terrain = Terrain::Generate(SmallWorld());
-  PinholeRadTan k;
-  k.width = 160;
-  k.height = 120;
-  k.fx = k.fy = 100.0;
-  k.cx = 79.5;
-  k.cy = 59.8;  // row 60's centre 0.2 px below the horizon, its top rays above
-  Eigen::Isometry3d T_world_cam = Eigen::Isometry3d::Identity();
-  T_world_cam.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // looking along +x, level
-  T_world_cam.translation() = Eigen::Vector3d(0, 0, terrain.Height(0, 0) + 2.0);
+  // Row 60's centre 0.2 px below the horizon, its top rays above.
+  const PinholeRadTan k = Pinhole(160, 120, 100.0, 79.5, 59.8);
+  const Eigen::Isometry3d T_world_cam = LevelAlongX(terrain);
   SimMarker m;
   m.id = 0;
   m.size = 0.5;
