@@ -38,11 +38,7 @@ MissionOptions ShortMission() {
 
 // Ids of the tags libapriltag finds in a rendered image, at full resolution.
 std::vector<int> DetectedTagIds(const std::vector<uint8_t>& pixels, const PinholeRadTan& k) {
-  Image image;
-  image.data = std::shared_ptr<const uint8_t[]>(pixels.data(), [](const uint8_t*) {});
-  image.width = k.width;
-  image.height = k.height;
-  image.stride = k.width;
+  const Image image = Image::GrayView(pixels.data(), k.width, k.height, k.width);
   TagDetectorOptions o;
   o.decimate = 1.0;
   const auto found = TagDetector(o).Detect(image);

@@ -37,13 +37,8 @@ TEST(TagViewRendererTest, TheDetectorFindsTheTagWhereItWasDrawn) {
   ASSERT_TRUE(view.ok()) << view.status().ToString();
   EXPECT_EQ(view->x0 % 2, 0);
   EXPECT_EQ(view->pixels.size(), static_cast<size_t>(view->width * view->height));
-  Image image;
-  image.data = std::shared_ptr<const uint8_t[]>(view->pixels.data(), [](const uint8_t*) {});
-  image.width = view->width;
-  image.height = view->height;
-  image.stride = view->width;
   TagDetector detector;
-  const auto found = detector.Detect(image);
+  const auto found = detector.Detect(Image::GrayView(view->pixels.data(), view->width, view->height, view->width));
   ASSERT_TRUE(found.ok());
   ASSERT_EQ(found->size(), 1u);
   EXPECT_EQ((*found)[0].id, 7);

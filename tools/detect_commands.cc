@@ -41,14 +41,7 @@ void WriteMatrix(JsonWriter& j, const char* key, const Eigen::MatrixXd& m) {
 }
 
 // A view of a continuous 8-bit gray cv::Mat (which must outlive it).
-Image GrayView(const cv::Mat& m) {
-  Image image;
-  image.data = std::shared_ptr<const uint8_t[]>(m.data, [](const uint8_t*) {});
-  image.width = m.cols;
-  image.height = m.rows;
-  image.stride = static_cast<int>(m.step[0]);
-  return image;
-}
+Image GrayView(const cv::Mat& m) { return Image::GrayView(m.data, m.cols, m.rows, static_cast<int>(m.step[0])); }
 
 double MsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();

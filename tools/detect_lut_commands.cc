@@ -123,12 +123,7 @@ Sighting RenderAndDetect(const sim::TagViewRenderer& renderer, const PinholeRadT
   }
   if (!view.ok()) return s;
   s.rendered = true;
-  Image image;
-  image.data = std::shared_ptr<const uint8_t[]>(view->pixels.data(), [](const uint8_t*) {});
-  image.width = view->width;
-  image.height = view->height;
-  image.stride = view->width;
-  const auto found = detector.Detect(image);
+  const auto found = detector.Detect(Image::GrayView(view->pixels.data(), view->width, view->height, view->width));
   if (!found.ok()) return s;
   for (const TagDetection& det : *found) {
     if (det.id != kTagId) continue;
@@ -226,11 +221,11 @@ int RunDetectBuildLut(const CommandArgs& args) {
     std::fprintf(stderr, "cairn detect build-lut: --camera and --out are needed\n%s", kBuildUsage);
     return 2;
   }
-  const sim::Terrain terrain = sim::Terrain::Generate(sim::WorldOptions{});
   if (camera_name.find_first_of(" \t\n#") != std::string::npos) {
     std::fprintf(stderr, "cairn detect build-lut: --camera '%s': a name without spaces or '#'\n", camera_name.c_str());
     return 2;
   }
+  const sim::Terrain terrain = sim::Terrain::Generate(sim::WorldOptions{});
   const auto camera = CameraOf(camera_name, intrinsics, terrain);
   if (!camera.ok()) {
     std::fprintf(stderr, "cairn detect build-lut: %s\n", camera.status().message().c_str());

@@ -22,6 +22,14 @@ std::string Fixed(double v, int digits) {
   return buf;
 }
 
+// The configured detector at `decimate`, for the table's ids unless others are configured (the
+// rest are counted as unknown).
+TagDetectorOptions DetectorOptions(TagDetectorOptions o, const TagCarrierTable& table, double decimate) {
+  if (o.ids.empty()) o.ids = table.Ids();
+  o.decimate = decimate;
+  return o;
+}
+
 }  // namespace
 
 Expected<TagErrorModel> RobotDetectionStage::MakeErrorModel(const RobotDetectionOptions& options,
@@ -58,17 +66,8 @@ RobotDetectionStage::RobotDetectionStage(const RobotDetectionOptions& options, T
       T_body_cam_(T_body_cam),
       robot_(robot),
       letter_(letter),
-      detector_([&] {
-        TagDetectorOptions o = options.detector;
-        if (o.ids.empty()) o.ids = table_.Ids();  // the rest are counted as unknown
-        return o;
-      }()),
-      region_detector_([&] {
-        TagDetectorOptions o = options.detector;
-        if (o.ids.empty()) o.ids = table_.Ids();
-        o.decimate = options.roi_decimate;
-        return o;
-      }()),
+      detector_(DetectorOptions(options.detector, table_, options.detector.decimate)),
+      region_detector_(DetectorOptions(options.detector, table_, options.roi_decimate)),
       full_every_(std::max<int64_t>(1, options.every_nth_frame / std::max<int64_t>(1, options.roi_every_nth_frame))) {
   camera_.width = camera.width;
   camera_.height = camera.height;

@@ -73,13 +73,7 @@ inline cv::Mat RenderTag(int id, double tag_size, const Eigen::Isometry3d& T_cam
 
 // A view of a continuous 8-bit cv::Mat as an Image (the Mat must outlive it).
 inline Image ImageOf(const cv::Mat& m) {
-  Image image;
-  image.data = std::shared_ptr<const uint8_t[]>(m.data, [](const uint8_t*) {});
-  image.width = m.cols;
-  image.height = m.rows;
-  image.stride = static_cast<int>(m.step[0]);
-  image.format = PixelFormat::kGray8;
-  return image;
+  return Image::GrayView(m.data, m.cols, m.rows, static_cast<int>(m.step[0]));
 }
 
 }  // namespace cairn::testing
