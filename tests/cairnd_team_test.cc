@@ -311,6 +311,9 @@ TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
       // Half-size images: the hexacopter sees the 0.32 m tag from 2.8 m.
       *std::find(args.begin(), args.end(), "sim.image_scale=0.25") = "sim.image_scale=0.5";
       args.insert(args.end(), {"--set", "sim.deploy_from_lander=true"});
+      // Each waits until both hold the same logs: 60 s was not enough with the sanitizers on a
+      // busy machine (the rover left without the hexacopter's last items).
+      *std::find(args.begin(), args.end(), "team.linger=60") = "team.linger=400";
       results[i] = RunProcess(args, options);
     });
   }
@@ -319,6 +322,7 @@ TEST(CairndTeamTest, RobotsDeployedFromTheLanderAreTiedThroughItsTags) {
     ASSERT_EQ(results[i].exit_code, 0) << results[i].output;
     const std::string out = dir + "/" + members[i]->name;
     const JsonValue t = JsonValue::ParseFile(out + "/team.json");
+    EXPECT_TRUE(t["settled"].boolean()) << members[i]->name << " left before it held its teammate's items";
     EXPECT_EQ(t["connected"].array().size(), 2u) << members[i]->name;
     EXPECT_EQ(t["not_connected"].array().size(), 0u) << members[i]->name;
     const std::string teammate = members[1 - i]->name;
