@@ -8,7 +8,8 @@
 #include <sstream>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+
+#include "io/image_codec.h"
 
 namespace cairn {
 namespace {
@@ -134,13 +135,7 @@ Status MapExporter::WriteGridMap(const GridMap& g, const std::string& png_path) 
       img.at<uint8_t>(g.height - 1 - y, x) = std::isnan(v) ? 205 : (v > 1.0f ? 0 : 254);
     }
   }
-  bool written = false;
-  try {
-    written = cv::imwrite(png_path, img);
-  } catch (const cv::Exception& e) {
-    return IoError("writing " + png_path + ": " + e.what());
-  }
-  if (!written) return IoError("writing " + png_path + " failed");
+  CAIRN_RETURN_IF_ERROR(ImageCodec::Write(png_path, img));
   const std::filesystem::path p(png_path);
   std::ostringstream y;
   y.precision(9);

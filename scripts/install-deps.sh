@@ -11,6 +11,8 @@ packages=(
   # libraries
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libfmt-dev libopencv-dev libsystemd-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  # image files (OpenCV's imgcodecs only in tests: it loads ~140 libraries)
+  libpng-dev libjpeg62-turbo-dev
   # recording (MCAP chunks) and the live Foxglove stream
   libzstd-dev liblz4-dev libprotobuf-dev protobuf-compiler libwebsocketpp-dev libasio-dev nodejs
   # SLAM graph back-end

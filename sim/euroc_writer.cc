@@ -4,7 +4,8 @@
 #include <filesystem>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+
+#include "io/image_codec.h"
 
 namespace cairn::sim {
 namespace {
@@ -120,7 +121,7 @@ Status EurocWriter::AddStereo(Timestamp time, const std::vector<uint8_t>& left,
   for (int c = 0; c < 2; ++c) {
     const std::string path = mav0_ + "/cam" + std::to_string(c) + "/data/" + name;
     const cv::Mat m(height, width, CV_8UC1, const_cast<uint8_t*>(images[c]->data()));
-    if (!cv::imwrite(path, m, {cv::IMWRITE_PNG_COMPRESSION, 1})) return IoError(path + ": cannot write PNG");
+    CAIRN_RETURN_IF_ERROR(ImageCodec::Write(path, m));
     std::fprintf(cam_[c], "%" PRId64 ",%s\n", time.nanoseconds(), name.c_str());
   }
   return Status::Ok();

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <limits>
 
-#include <opencv2/imgcodecs.hpp>
+#include "io/image_codec.h"
 
 namespace cairn {
 
@@ -31,8 +31,9 @@ const char* DisparityMetricName(DisparityMetric metric) {
 Expected<FloatImage> LoadGroundTruth(const std::string& path, double scale) {
   if (path.size() > 4 && path.substr(path.size() - 4) == ".pfm") return ReadPfm(path);
   if (!std::filesystem::is_regular_file(path)) return NotFoundError("no such ground truth file " + path);
-  const cv::Mat m = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
-  if (m.empty()) return NotFoundError("cannot read ground truth image " + path);
+  const auto read = ImageCodec::Read(path, ImageReadMode::kGrayAnyDepth);
+  if (!read.ok()) return read.status();
+  const cv::Mat& m = *read;
   if (m.depth() != CV_8U && m.depth() != CV_16U) {
     return DataLossError(path + ": ground truth must be an 8- or 16-bit PNG or a PFM");
   }
@@ -51,8 +52,9 @@ Expected<FloatImage> LoadGroundTruth(const std::string& path, double scale) {
 
 Expected<FloatImage> LoadMask(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) return NotFoundError("no such mask file " + path);
-  const cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (m.empty()) return DataLossError("cannot decode mask image " + path);
+  const auto read = ImageCodec::Read(path, ImageReadMode::kGray8);
+  if (!read.ok()) return read.status();
+  const cv::Mat& m = *read;
   FloatImage img{m.cols, m.rows, {}};
   img.data.resize(static_cast<size_t>(m.cols) * m.rows);
   for (int y = 0; y < m.rows; ++y) {

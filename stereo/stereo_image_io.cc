@@ -4,21 +4,20 @@
 #include <filesystem>
 #include <limits>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "io/image_codec.h"
 
 namespace cairn {
 
 Expected<GrayPair> LoadGrayPair(const std::string& left_path, const std::string& right_path) {
   GrayPair pair;
-  // Checked first so that a missing file gives our message, not only OpenCV's warning.
-  for (const std::string& p : {left_path, right_path}) {
-    if (!std::filesystem::is_regular_file(p)) return NotFoundError("no such image file " + p);
-  }
-  pair.left = cv::imread(left_path, cv::IMREAD_GRAYSCALE);
-  if (pair.left.empty()) return NotFoundError("cannot read left image " + left_path);
-  pair.right = cv::imread(right_path, cv::IMREAD_GRAYSCALE);
-  if (pair.right.empty()) return NotFoundError("cannot read right image " + right_path);
+  auto left = ImageCodec::Read(left_path, ImageReadMode::kGray8);
+  if (!left.ok()) return left.status();
+  auto right = ImageCodec::Read(right_path, ImageReadMode::kGray8);
+  if (!right.ok()) return right.status();
+  pair.left = std::move(*left);
+  pair.right = std::move(*right);
   if (pair.left.size() != pair.right.size()) {
     return InvalidArgumentError("left image " + left_path + " is " +
                                 std::to_string(pair.left.cols) + "x" +
@@ -58,12 +57,7 @@ Status WriteDisparityPng(const std::string& path, const StereoMatcherOutput& out
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_JET);
   colour.setTo(cv::Scalar(0, 0, 0), invalid);
-  try {
-    if (!cv::imwrite(path, colour)) return IoError("cannot write " + path);
-  } catch (const cv::Exception& e) {
-    return IoError("cannot write " + path + ": " + e.what());
-  }
-  return Status::Ok();
+  return ImageCodec::Write(path, colour);
 }
 
 }  // namespace cairn

@@ -30,7 +30,7 @@ const std::vector<Part>& Parts() {
       {"common/", {}},
       {"io/", {"common/"}},
       {"hal/", {"common/"}},
-      {"stereo/", {"hal/", "common/"}},
+      {"stereo/", {"hal/", "io/", "common/"}},
       {"estimation/math/", {"common/"}},
       {"estimation/filter/", {"estimation/math/", "hal/", "common/"}},
       {"estimation/eval/", {"estimation/math/", "common/"}},

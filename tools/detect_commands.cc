@@ -10,12 +10,11 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "common/json_writer.h"
 #include "detection/tag_detector.h"
 #include "detection/tag_pose_estimator.h"
 #include "drivers/replay/euroc_dataset.h"
+#include "io/image_codec.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
@@ -126,17 +125,12 @@ int RunDetect(const CommandArgs& args) {
       camera.k1 = intrinsics[4], camera.k2 = intrinsics[5], camera.p1 = intrinsics[6], camera.p2 = intrinsics[7];
     }
   }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(image_path, ec)) {
-    std::fprintf(stderr, "cairn detect: %s: no such file\n", image_path.c_str());
+  const auto read = ImageCodec::Read(image_path, ImageReadMode::kGray8);
+  if (!read.ok()) {
+    std::fprintf(stderr, "cairn detect: %s\n", read.status().message().c_str());
     return 1;
   }
-  const cv::Mat gray = cv::imread(image_path, cv::IMREAD_GRAYSCALE);
-  if (gray.empty()) {
-    std::fprintf(stderr, "cairn detect: %s: cannot read the image (missing, empty or not an image format)\n",
-                 image_path.c_str());
-    return 1;
-  }
+  const cv::Mat& gray = *read;
   if (camera.width > 0 && (camera.width != gray.cols || camera.height != gray.rows)) {
     std::fprintf(stderr, "cairn detect: %s is %dx%d, the camera in %s is %dx%d\n", image_path.c_str(), gray.cols,
                  gray.rows, camera_path.c_str(), camera.width, camera.height);

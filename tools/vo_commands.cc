@@ -12,13 +12,12 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "common/json_writer.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
 #include "drivers/replay/euroc_dataset.h"
 #include "estimation/eval/trajectory_evaluator.h"
 #include "estimation/vo/keyframe_visual_odometry.h"
+#include "io/image_codec.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
@@ -150,11 +149,14 @@ int RunBenchVo(const CommandArgs& args) {
   // Load and rectify every pair up front: the timing covers the odometry only.
   std::vector<std::pair<cv::Mat, cv::Mat>> pairs;
   for (const EurocStereoEntry& e : ds->stereo()) {
-    cv::Mat l = cv::imread(e.left_path, cv::IMREAD_GRAYSCALE), r = cv::imread(e.right_path, cv::IMREAD_GRAYSCALE);
-    if (l.empty() || r.empty()) {
-      std::fprintf(stderr, "cairn bench vo: cannot read %s or %s\n", e.left_path.c_str(), e.right_path.c_str());
+    auto left = ImageCodec::Read(e.left_path, ImageReadMode::kGray8);
+    auto right = ImageCodec::Read(e.right_path, ImageReadMode::kGray8);
+    if (!left.ok() || !right.ok()) {
+      std::fprintf(stderr, "cairn bench vo: %s\n", (left.ok() ? right : left).status().message().c_str());
       return 1;
     }
+    cv::Mat l = std::move(*left);
+    cv::Mat r = std::move(*right);
     StereoFrame f;
     const auto image = [](const cv::Mat& m) {
       Image im;

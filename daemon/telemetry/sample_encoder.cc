@@ -3,8 +3,6 @@
 #include <algorithm>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "cairn/sensors.pb.h"
 #include "daemon/telemetry/foxglove_fields.h"
@@ -13,6 +11,7 @@
 #include "foxglove/Grid.pb.h"
 #include "foxglove/PointCloud.pb.h"
 #include "foxglove/PoseInFrame.pb.h"
+#include "io/image_codec.h"
 #include "foxglove/RawImage.pb.h"
 
 namespace cairn {
@@ -122,19 +121,13 @@ bool SampleEncoder::Compressed(const cairn::Image& img, Timestamp t, const char*
                                const ImageEncodingOptions& options, const std::string** encoded) {
   if (img.empty()) return false;
   const int type = img.format == PixelFormat::kGray8 ? CV_8UC1 : CV_8UC3;
-  cv::Mat view(img.height, img.width, type, const_cast<uint8_t*>(img.data.get()), static_cast<size_t>(img.stride));
-  cv::Mat bgr;
-  if (img.format == PixelFormat::kRgb8) cv::cvtColor(view, bgr, cv::COLOR_RGB2BGR);  // codecs take BGR
-  const cv::Mat& pixels = img.format == PixelFormat::kRgb8 ? bgr : view;
+  const cv::Mat pixels(img.height, img.width, type, const_cast<uint8_t*>(img.data.get()), static_cast<size_t>(img.stride));
+  const ColourOrder order = img.format == PixelFormat::kRgb8 ? ColourOrder::kRgb : ColourOrder::kBgr;
   const bool jpeg = options.format == ImageFormat::kJpeg;
-  const std::vector<int> params =
-      jpeg ? std::vector<int>{cv::IMWRITE_JPEG_QUALITY, static_cast<int>(options.jpeg_quality)}
-           : std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1};  // fast: the telemetry core is shared
-  try {
-    if (!cv::imencode(jpeg ? ".jpg" : ".png", pixels, codec_buffer_, params)) return false;
-  } catch (const cv::Exception&) {
-    return false;
-  }
+  // PNG at level 1: fast, the telemetry core is shared.
+  const Status status = jpeg ? ImageCodec::EncodeJpeg(pixels, static_cast<int>(options.jpeg_quality), &codec_buffer_, order)
+                              : ImageCodec::EncodePng(pixels, 1, &codec_buffer_, order);
+  if (!status.ok()) return false;
   foxglove::CompressedImage m;
   SetFoxgloveTime(t, m.mutable_timestamp());
   m.set_frame_id(frame_id);

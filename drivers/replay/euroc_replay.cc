@@ -1,6 +1,8 @@
 #include "drivers/replay/euroc_replay.h"
 
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>
+
+#include "io/image_codec.h"
 
 namespace cairn {
 namespace {
@@ -39,14 +41,16 @@ void EurocReplay::Stop() {
 }
 
 bool EurocReplay::PublishStereo(const EurocStereoEntry& entry, uint64_t counter) {
-  const cv::Mat left = cv::imread(entry.left_path, cv::IMREAD_UNCHANGED);
-  const cv::Mat right = cv::imread(entry.right_path, cv::IMREAD_UNCHANGED);
   const auto fault = [&](const std::string& detail) {
     sink_->OnDeviceFault(DeviceFault{entry.time, "replay/stereo", DeviceFaultKind::kCorruptSample, detail});
     return false;
   };
-  if (left.empty()) return fault(entry.left_path + ": cannot decode image");
-  if (right.empty()) return fault(entry.right_path + ": cannot decode image");
+  const auto left_read = ImageCodec::Read(entry.left_path, ImageReadMode::kUnchanged);
+  if (!left_read.ok()) return fault(left_read.status().message());
+  const auto right_read = ImageCodec::Read(entry.right_path, ImageReadMode::kUnchanged);
+  if (!right_read.ok()) return fault(right_read.status().message());
+  const cv::Mat& left = *left_read;
+  const cv::Mat& right = *right_read;
   if (left.size() != right.size() || left.type() != right.type() ||
       (left.channels() != 1 && left.channels() != 3) || left.depth() != CV_8U) {
     return fault(entry.left_path + ": left and right images differ in size or type, or are not 8-bit");

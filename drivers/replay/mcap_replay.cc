@@ -5,11 +5,11 @@
 #include <memory>
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "cairn/sensors.pb.h"
 #include "foxglove/CompressedImage.pb.h"
 #include "foxglove/RawImage.pb.h"
+#include "io/image_codec.h"
 #include "io/mcap/mcap_reader.h"
 
 namespace cairn {
@@ -44,14 +44,11 @@ Expected<Image> ToImage(const foxglove::CompressedImage& m, const std::string& w
   if (m.format() != "jpeg" && m.format() != "png") {
     return DataLossError(where + ": unsupported compressed image format '" + m.format() + "'");
   }
-  cv::Mat decoded;
-  try {
-    const cv::Mat bytes(1, static_cast<int>(m.data().size()), CV_8UC1, const_cast<char*>(m.data().data()));
-    decoded = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    decoded.release();
-  }
-  if (decoded.empty() || decoded.depth() != CV_8U || (decoded.channels() != 1 && decoded.channels() != 3)) {
+  const auto result = ImageCodec::Decode({reinterpret_cast<const uint8_t*>(m.data().data()), m.data().size()},
+                                         ImageReadMode::kUnchanged, where);
+  if (!result.ok()) return result.status();
+  const cv::Mat& decoded = *result;
+  if (decoded.depth() != CV_8U || (decoded.channels() != 1 && decoded.channels() != 3)) {
     return DataLossError(where + ": " + m.format() + " image does not decode to 8-bit gray or colour");
   }
   const int row_bytes = decoded.cols * decoded.channels();
