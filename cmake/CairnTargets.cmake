@@ -58,15 +58,20 @@ function(cairn_library name)
   cairn_use_pch(${name} cairn_pch)
 endfunction()
 
-# cairn_test(NAME SOURCES ... DEPS ... [LABELS ...]): one GoogleTest binary, each TEST a ctest entry.
-# Tests find the shared data through CAIRN_DATA_DIR and skip, naming the path, when it is missing.
+# cairn_test(NAME SOURCES ... DEPS ... [LABELS ...] [TIMEOUT s] [COST s]): one GoogleTest binary,
+# each TEST a ctest entry. Tests find the shared data through CAIRN_DATA_DIR and skip, naming the
+# path, when it is missing. COST, the longest test's seconds under the sanitizers, lets a fresh
+# clone (no timings of an earlier run) start the long tests first instead of last, alone.
 function(cairn_test name)
   if(NOT CAIRN_BUILD_TESTS OR CAIRN_PORTABLE_CORE_ONLY)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT;COST" "SOURCES;DEPS;LABELS" ${ARGN})
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
+  endif()
+  if(NOT ARG_COST)
+    set(ARG_COST 0)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gmock GTest::gtest_main)
@@ -91,6 +96,7 @@ function(cairn_test name)
     PROPERTIES
       LABELS "${labels}"
       TIMEOUT ${ARG_TIMEOUT}
+      COST ${ARG_COST}
       ENVIRONMENT "CAIRN_DATA_DIR=${CAIRN_DATA_DIR}")
 endfunction()
 
