@@ -52,10 +52,35 @@ Status Compressor::Compress(Compression c, std::span<const uint8_t> in, std::vec
 
 Status Compressor::Decompress(Compression c, std::span<const uint8_t> in,
                               uint64_t uncompressed_size, std::vector<uint8_t>* out) {
-  out->resize(uncompressed_size);
+  // The size comes with the block, from a file or a teammate: checked before it is allocated.
+  if (uncompressed_size > kMaxUncompressedBytes) {
+    return DataLossError("block claims " + std::to_string(uncompressed_size) + " bytes uncompressed, more than 1 GiB");
+  }
   switch (c) {
     case Compression::kNone:
       if (in.size() != uncompressed_size) return DataLossError("uncompressed chunk size mismatch");
+      break;
+    case Compression::kZstd: {
+      // Our writers (and most others) put the content size in the frame.
+      const unsigned long long content = ZSTD_getFrameContentSize(in.data(), in.size());
+      if (content == ZSTD_CONTENTSIZE_ERROR) return DataLossError("zstd: not a zstd frame");
+      if (content != ZSTD_CONTENTSIZE_UNKNOWN && content != uncompressed_size) {
+        return DataLossError("zstd chunk decompresses to " + std::to_string(content) + " bytes, not the " +
+                             std::to_string(uncompressed_size) + " it claims");
+      }
+      break;
+    }
+    case Compression::kLz4:
+      // LZ4 expands at most about 255 times.
+      if (uncompressed_size > 255 * static_cast<uint64_t>(in.size()) + 64) {
+        return DataLossError("lz4 chunk of " + std::to_string(in.size()) + " bytes cannot hold the " +
+                             std::to_string(uncompressed_size) + " it claims");
+      }
+      break;
+  }
+  out->resize(uncompressed_size);
+  switch (c) {
+    case Compression::kNone:
       std::memcpy(out->data(), in.data(), in.size());
       return Status::Ok();
     case Compression::kZstd: {

@@ -22,7 +22,10 @@ class Compressor {
   // speed for size (1: recordings, which must keep up with the sensors).
   static Status Compress(Compression c, std::span<const uint8_t> in, std::vector<uint8_t>* out,
                          int zstd_level = 1);
-  // Decompresses into exactly `uncompressed_size` bytes or fails.
+  static constexpr uint64_t kMaxUncompressedBytes = uint64_t{1} << 30;
+
+  // Decompresses into exactly `uncompressed_size` bytes or fails, without allocating a size the
+  // compressed bytes cannot hold (at most kMaxUncompressedBytes).
   static Status Decompress(Compression c, std::span<const uint8_t> in,
                            uint64_t uncompressed_size, std::vector<uint8_t>* out);
 };

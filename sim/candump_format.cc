@@ -44,6 +44,8 @@ Expected<CandumpRecord> ParseCandumpLine(const std::string& line) {
   if (end != line.c_str() + dot) return DataLossError("bad seconds in timestamp");
   const long long usec = std::strtoll(line.c_str() + dot + 1, &end, 10);
   if (end != line.c_str() + close || close - dot - 1 != 6) return DataLossError("timestamp needs 6 microsecond digits");
+  // int64 nanoseconds reach the year 2262; a sign or more digits is not a time.
+  if (sec < 0 || sec > 9000000000LL || usec < 0) return DataLossError("timestamp out of range");
   r.time = Timestamp::FromNanoseconds(sec * 1000000000LL + usec * 1000LL);
   const size_t if_begin = line.find_first_not_of(' ', close + 1);
   const size_t if_end = line.find(' ', if_begin);

@@ -33,7 +33,9 @@ TEST(CandumpFormatTest, FormatsAndParsesStandardAndExtendedFrames) {
 
 TEST(CandumpFormatTest, RejectsMalformedLines) {
   for (const char* bad : {"", "1.000000 can0 101#00", "(1.0) can0 101#00", "(1.000000) can0 101",
-                          "(1.000000) can0 1G1#00", "(1.000000) can0 101#0", "(1.000000) can0 101#001122334455667788"}) {
+                          "(1.000000) can0 1G1#00", "(1.000000) can0 101#0", "(1.000000) can0 101#001122334455667788",
+                          // beyond int64 nanoseconds, or negative
+                          "(176489282800.000000) can0 101#00", "(-1.000000) can0 101#00", "(1.-00001) can0 101#00"}) {
     EXPECT_FALSE(ParseCandumpLine(bad).ok()) << bad;
   }
 }

@@ -1,6 +1,11 @@
 #include "io/mcap/mcap_reader.h"
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <memory>
 
@@ -123,6 +128,9 @@ Expected<McapScanResult> McapReader::Scan(const MessageCallback& on_message,
   if (std::fread(magic, 1, 8, f.get()) != 8 || std::memcmp(magic, kMagic, 8) != 0) {
     return DataLossError(path_ + ": not an MCAP file (bad magic)");
   }
+  // A record longer than the rest of the file is a truncated file, not a size to allocate.
+  struct stat st {};
+  const uint64_t file_size = fstat(fileno(f.get()), &st) == 0 ? static_cast<uint64_t>(st.st_size) : UINT64_MAX;
   McapScanResult result;
   uint64_t offset = 8;
   std::vector<uint8_t> body;
@@ -144,6 +152,10 @@ Expected<McapScanResult> McapReader::Scan(const MessageCallback& on_message,
     if (first && op != 0x01) return DataLossError(path_ + ": first record is not a header");
     first = false;
     if (len > (uint64_t{1} << 40)) return DataLossError(At(path_, offset) + ": implausible record length");
+    if (len > file_size - std::min(file_size, offset + 9)) {
+      result.truncated = true;
+      break;
+    }
     body.resize(static_cast<size_t>(len));
     if (std::fread(body.data(), 1, body.size(), f.get()) != body.size()) {
       result.truncated = true;
