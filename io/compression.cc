@@ -81,7 +81,7 @@ Status Compressor::Decompress(Compression c, std::span<const uint8_t> in,
   out->resize(uncompressed_size);
   switch (c) {
     case Compression::kNone:
-      std::memcpy(out->data(), in.data(), in.size());
+      if (!in.empty()) std::memcpy(out->data(), in.data(), in.size());  // an empty block may have no data
       return Status::Ok();
     case Compression::kZstd: {
       const size_t n = ZSTD_decompress(out->data(), out->size(), in.data(), in.size());

@@ -19,6 +19,12 @@ TEST(CompressorTest, EveryCodecRoundTrips) {
   }
 }
 
+TEST(CompressorTest, AnEmptyBlockDecompressesToNothing) {
+  std::vector<uint8_t> back(3, 1);
+  EXPECT_TRUE(Compressor::Decompress(Compression::kNone, {}, 0, &back).ok());
+  EXPECT_TRUE(back.empty());
+}
+
 // A block from a file or a teammate that claims more bytes than it can hold is refused before
 // anything that size is allocated.
 TEST(CompressorTest, ASizeTheBlockCannotHoldIsRefusedUnallocated) {
