@@ -79,6 +79,7 @@ bool ReadImage(png_structp png, png_infop info, ImageReadMode mode, cv::Mat* ima
     if ((colour & PNG_COLOR_MASK_COLOR) != 0 || colour == PNG_COLOR_TYPE_PALETTE) png_set_bgr(png);
     if (colour == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(png);  // BGRA, as OpenCV gives
   }
+  png_set_interlace_handling(png);  // Adam7 files: png_read_image merges the passes
   png_read_update_info(png, info);
   const int channels = png_get_channels(png, info);
   const int out_depth = png_get_bit_depth(png, info);
