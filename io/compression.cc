@@ -1,9 +1,10 @@
 #include "io/compression.h"
 
+#include <cstring>
+
 #include <lz4frame.h>
 #include <zstd.h>
 
-#include <cstring>
 
 namespace cairn {
 
@@ -59,7 +60,8 @@ Status Compressor::Decompress(Compression c, std::span<const uint8_t> in,
   switch (c) {
     case Compression::kNone:
       if (in.size() != uncompressed_size) return DataLossError("uncompressed chunk size mismatch");
-      break;
+      out->assign(in.begin(), in.end());
+      return Status::Ok();
     case Compression::kZstd: {
       // Our writers (and most others) put the content size in the frame.
       const unsigned long long content = ZSTD_getFrameContentSize(in.data(), in.size());
@@ -68,28 +70,19 @@ Status Compressor::Decompress(Compression c, std::span<const uint8_t> in,
         return DataLossError("zstd chunk decompresses to " + std::to_string(content) + " bytes, not the " +
                              std::to_string(uncompressed_size) + " it claims");
       }
-      break;
-    }
-    case Compression::kLz4:
-      // LZ4 expands at most about 255 times.
-      if (uncompressed_size > 255 * static_cast<uint64_t>(in.size()) + 64) {
-        return DataLossError("lz4 chunk of " + std::to_string(in.size()) + " bytes cannot hold the " +
-                             std::to_string(uncompressed_size) + " it claims");
-      }
-      break;
-  }
-  out->resize(uncompressed_size);
-  switch (c) {
-    case Compression::kNone:
-      if (!in.empty()) std::memcpy(out->data(), in.data(), in.size());  // an empty block may have no data
-      return Status::Ok();
-    case Compression::kZstd: {
+      out->resize(uncompressed_size);
       const size_t n = ZSTD_decompress(out->data(), out->size(), in.data(), in.size());
       if (ZSTD_isError(n)) return DataLossError(std::string("zstd: ") + ZSTD_getErrorName(n));
       if (n != uncompressed_size) return DataLossError("zstd chunk decompressed to the wrong size");
       return Status::Ok();
     }
     case Compression::kLz4: {
+      // LZ4 expands at most about 255 times.
+      if (uncompressed_size > 255 * static_cast<uint64_t>(in.size()) + 64) {
+        return DataLossError("lz4 chunk of " + std::to_string(in.size()) + " bytes cannot hold the " +
+                             std::to_string(uncompressed_size) + " it claims");
+      }
+      out->resize(uncompressed_size);
       LZ4F_dctx* ctx = nullptr;
       if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) {
         return InternalError("lz4: cannot create a decompression context");

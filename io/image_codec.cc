@@ -12,8 +12,6 @@
 namespace cairn {
 namespace {
 
-constexpr uint64_t kMaxPixelBytes = uint64_t{1} << 30;
-
 std::string Extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -82,7 +80,7 @@ Expected<cv::Mat> DecodePnm(std::span<const uint8_t> bytes, ImageReadMode mode, 
   ++at;  // the single whitespace before the pixels
   const int sample_bytes = maxval > 255 ? 2 : 1;
   const uint64_t row_bytes = static_cast<uint64_t>(width) * (colour ? 3 : 1) * sample_bytes;
-  if (row_bytes * static_cast<uint64_t>(height) > kMaxPixelBytes) return DataLossError(where + ": image larger than 1 GiB");
+  if (row_bytes * static_cast<uint64_t>(height) > ImageCodec::kMaxPixelBytes) return DataLossError(where + ": image larger than 1 GiB");
   if (bytes.size() - at < row_bytes * static_cast<uint64_t>(height)) {
     return DataLossError(where + ": PGM/PPM pixels end early (" + std::to_string(bytes.size() - at) + " of " +
                          std::to_string(row_bytes * static_cast<uint64_t>(height)) + " bytes)");

@@ -29,6 +29,9 @@ enum class ColourOrder { kBgr, kRgb };
 
 class ImageCodec {
  public:
+  // A corrupt header must not make a decoder allocate more than this.
+  static constexpr uint64_t kMaxPixelBytes = uint64_t{1} << 30;
+
   // Decodes PNG, JPEG or binary PGM/PPM (P5/P6), recognised by their first bytes. `where` names
   // the source in errors.
   static Expected<cv::Mat> Decode(std::span<const uint8_t> bytes, ImageReadMode mode, const std::string& where);

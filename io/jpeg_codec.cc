@@ -11,8 +11,6 @@
 namespace cairn {
 namespace {
 
-constexpr uint64_t kMaxPixelBytes = uint64_t{1} << 30;
-
 // libjpeg reports errors through error_exit, which must not return: it jumps back to the frame
 // that called setjmp. What must outlive an error lives here, in the caller's frame.
 struct JpegError {
@@ -53,7 +51,7 @@ bool ReadImage(jpeg_decompress_struct* jpeg, JpegError* error, std::span<const u
   jpeg->out_color_space = gray ? JCS_GRAYSCALE : JCS_EXT_BGR;
   jpeg_start_decompress(jpeg);
   const int channels = static_cast<int>(jpeg->output_components);
-  if (uint64_t{jpeg->output_width} * jpeg->output_height * static_cast<uint64_t>(channels) > kMaxPixelBytes) {
+  if (uint64_t{jpeg->output_width} * jpeg->output_height * static_cast<uint64_t>(channels) > ImageCodec::kMaxPixelBytes) {
     std::snprintf(error->message, sizeof(error->message), "image larger than 1 GiB");
     return false;
   }

@@ -8,9 +8,6 @@
 namespace cairn {
 namespace {
 
-// A corrupt header must not make us allocate gigabytes.
-constexpr uint64_t kMaxPixelBytes = uint64_t{1} << 30;
-
 constexpr bool kLittleEndian = __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__;
 
 // libpng reports errors by longjmp: everything a reader or writer must keep past an error lives
@@ -84,7 +81,7 @@ bool ReadImage(png_structp png, png_infop info, ImageReadMode mode, cv::Mat* ima
   const int channels = png_get_channels(png, info);
   const int out_depth = png_get_bit_depth(png, info);
   if (channels < 1 || channels > 4 || (out_depth != 8 && out_depth != 16)) png_error(png, "unexpected pixel layout");
-  if (uint64_t{width} * height * static_cast<uint64_t>(channels) * (out_depth / 8) > kMaxPixelBytes) {
+  if (uint64_t{width} * height * static_cast<uint64_t>(channels) * (out_depth / 8) > ImageCodec::kMaxPixelBytes) {
     png_error(png, "image larger than 1 GiB");
   }
   image->create(static_cast<int>(height), static_cast<int>(width), CV_MAKETYPE(out_depth == 16 ? CV_16U : CV_8U, channels));
@@ -95,8 +92,7 @@ bool ReadImage(png_structp png, png_infop info, ImageReadMode mode, cv::Mat* ima
   return true;
 }
 
-bool WriteImage(png_structp png, png_infop info, const cv::Mat& image, int level, ColourOrder order,
-                std::vector<png_bytep>* rows) {
+bool WriteImage(png_structp png, png_infop info, const cv::Mat& image, int level, ColourOrder order) {
   if (setjmp(png_jmpbuf(png))) return false;
   const int channels = image.channels();
   const int colour = channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA;
@@ -109,9 +105,7 @@ bool WriteImage(png_structp png, png_infop info, const cv::Mat& image, int level
   png_write_info(png, info);
   if (channels >= 3 && order == ColourOrder::kBgr) png_set_bgr(png);
   if (image.depth() == CV_16U && kLittleEndian) png_set_swap(png);
-  rows->resize(static_cast<size_t>(image.rows));
-  for (int y = 0; y < image.rows; ++y) (*rows)[static_cast<size_t>(y)] = const_cast<png_bytep>(image.ptr<png_byte>(y));
-  png_write_image(png, rows->data());
+  for (int y = 0; y < image.rows; ++y) png_write_row(png, image.ptr<png_byte>(y));
   png_write_end(png, info);
   return true;
 }
@@ -157,8 +151,7 @@ Status PngCodec::Encode(const cv::Mat& image, int level, ColourOrder order, std:
     return InternalError("cannot start the PNG encoder");
   }
   png_set_write_fn(png, &state, WriteBytes, Flush);
-  std::vector<png_bytep> rows;
-  const bool ok = WriteImage(png, info, image, level, order, &rows);
+  const bool ok = WriteImage(png, info, image, level, order);
   png_destroy_write_struct(&png, &info);
   if (!ok) return InternalError(std::string("PNG encoding failed: ") + state.error);
   return Status::Ok();

@@ -13,6 +13,7 @@
 #include "daemon/comms/exchange.h"
 #include "daemon/comms/item_store.h"
 #include "daemon/comms/team_item_codec.h"
+#include "tests/fuzz/team_names.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string dir = "/tmp/cairn_fuzz_exchange_" + std::to_string(getpid());
@@ -21,11 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   store_options.fsync = false;
   auto store = cairn::ItemStore::Open(dir, store_options);
   if (!store.ok()) return 0;
-  cairn::TeamItemCodec::Names names;
-  names.letter_of = [](const std::string& robot) { return robot == "a" ? 'a' : robot == "b" ? 'b' : '\0'; };
-  names.frame_index = [](const std::string&, uint32_t incarnation, uint64_t frame) {
-    return (uint64_t{incarnation} << 40) + frame;
-  };
+  const cairn::TeamItemCodec::Names names = cairn::fuzz::TeamNames();
   cairn::Exchange exchange("a", {"b", "c"}, **store, cairn::ExchangeOptions{},
                            [&](const cairn::StoreItem& item) { (void)cairn::TeamItemCodec::Decode(item, names); });
   exchange.ReplayStore();

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "daemon/comms/team_item_codec.h"
+#include "tests/fuzz/team_names.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
@@ -13,11 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   item.key.seq = 1;
   item.kind = static_cast<uint16_t>(data[0] % 9);
   item.payload.assign(reinterpret_cast<const char*>(data + 1), size - 1);
-  cairn::TeamItemCodec::Names names;
-  names.letter_of = [](const std::string& robot) { return robot == "a" ? 'a' : robot == "b" ? 'b' : '\0'; };
-  names.frame_index = [](const std::string&, uint32_t incarnation, uint64_t frame) {
-    return (uint64_t{incarnation} << 40) + frame;
-  };
+  const cairn::TeamItemCodec::Names names = cairn::fuzz::TeamNames();
   (void)cairn::TeamItemCodec::Decode(item, names);
   (void)cairn::TeamItemCodec::IncarnationOf(item);
   return 0;
