@@ -105,10 +105,11 @@ if(NOT TARGET concurrency_tests)
   add_custom_target(concurrency_tests)
 endif()
 
-# Generated sources of `target` (everything outside the source tree: Verilator's model and
-# runtime, protoc's output) are compiled without the sanitizers of a CAIRN_SANITIZER build. It is
-# not our code to fix, its instrumentation was a tenth of the sanitizer builds' compile time, and
-# the cosimulation tests spend their time in it. Our code that calls it stays instrumented.
+# Generated sources of `target` (everything outside the source tree or inside the build tree:
+# Verilator's model and runtime, protoc's output) are compiled without the sanitizers of a
+# CAIRN_SANITIZER build. It is not our code to fix, its instrumentation was a tenth of the
+# sanitizer builds' compile time, and the cosimulation tests spend their time in it. Our code
+# that calls it stays instrumented.
 function(cairn_generated_without_sanitizers target)
   if(NOT CAIRN_SANITIZER)
     return()
@@ -117,7 +118,9 @@ function(cairn_generated_without_sanitizers target)
   foreach(src IN LISTS sources)
     cmake_path(ABSOLUTE_PATH src BASE_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR} NORMALIZE OUTPUT_VARIABLE abs)
     cmake_path(IS_PREFIX PROJECT_SOURCE_DIR "${abs}" NORMALIZE in_tree)
-    if(NOT in_tree AND abs MATCHES "\\.(c|cc|cpp|cxx)$")
+    # The presets' build folders lie inside the source tree; what is generated there is not ours.
+    cmake_path(IS_PREFIX PROJECT_BINARY_DIR "${abs}" NORMALIZE in_build)
+    if((NOT in_tree OR in_build) AND abs MATCHES "\\.(c|cc|cpp|cxx)$")
       set_property(SOURCE ${src} TARGET_DIRECTORY ${target} APPEND PROPERTY COMPILE_OPTIONS -fno-sanitize=all)
     endif()
   endforeach()
