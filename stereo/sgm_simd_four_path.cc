@@ -548,6 +548,16 @@ static void FourPathCensusSimd(const uint8_t* center, ptrdiff_t stride, int widt
   }
 }
 
+// Compile-time vector counts pay only where vectors are real: on the emulated target the
+// unrolled specialisations cost most of this file's compile time (half a minute under ASan)
+// and buy nothing, so it runs the general kernels.
+#ifdef CAIRN_SGM_FOUR_PATH_KERNELS
+constexpr bool kSpecialise = HWY_TARGET != HWY_EMU128;
+// 0 means "read at run time", so on the emulated target every call below is the general one.
+constexpr int kFourVectors = kSpecialise ? 4 : 0;
+constexpr int kThreePlanes = kSpecialise ? 3 : 0;
+#endif
+
 static bool HasFourPathSimd() {
 #ifdef CAIRN_SGM_FOUR_PATH_KERNELS
   return true;
@@ -566,10 +576,10 @@ static void FourPathVerticalSimd(const SgmCostRow& c, const SgmRowGeometry& g,
   const auto run = [&](auto d) {
     const bool four = g.disparities == 4 * static_cast<int>(hn::Lanes(d));
     if (four && c.planes == 3) {
-      VerticalImpl<4, 3>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
+      VerticalImpl<kFourVectors, kThreePlanes>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
                          out_min, cost_out);
     } else if (four) {
-      VerticalImpl<4, 0>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
+      VerticalImpl<kFourVectors, 0>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
                          out_min, cost_out);
     } else {
       VerticalImpl<0, 0>(d, c, g, image_row, prev_image_row, p2_table, p1, prev, prev_min, out,
@@ -605,9 +615,9 @@ static void FourPathFinishRowSimd(const SgmCostRow& c, const SgmRowGeometry& g,
     const bool four = g.disparities == 4 * static_cast<int>(hn::Lanes(d));
     if (four && c.planes == 3) {
       if (narrow) {
-        FinishRowImpl<4, 3, uint8_t>(d, a, scratch, right_best);
+        FinishRowImpl<kFourVectors, kThreePlanes, uint8_t>(d, a, scratch, right_best);
       } else {
-        FinishRowImpl<4, 3, uint16_t>(d, a, scratch, right_best);
+        FinishRowImpl<kFourVectors, kThreePlanes, uint16_t>(d, a, scratch, right_best);
       }
     } else if (narrow) {
       FinishRowImpl<0, 0, uint8_t>(d, a, scratch, right_best);
