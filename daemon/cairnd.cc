@@ -14,6 +14,7 @@
 #include "daemon/run_summary.h"
 #include "daemon/submap_index.h"
 #include "daemon/detections_csv.h"
+#include "daemon/earlier_runs.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/team_summary.h"
@@ -124,11 +125,42 @@ Status Cairnd::Prepare() {
                                 ": no sensor source is enabled (this build has replay and SocketCAN "
                                 "wheel odometry; camera and IMU device drivers are not built yet)");
   }
+  // Only once the sources are good: a start that fails moves nothing.
+  KeepEarlierRun();
   // Fail before any work if the output folder cannot be made.
   std::error_code ec;
   std::filesystem::create_directories(options_.output.dir, ec);
   if (ec) return IoError(options_.output.dir + ": cannot create the output folder: " + ec.message());
   return Status::Ok();
+}
+
+void Cairnd::KeepEarlierRun() {
+  const std::string& dir = options_.output.dir;
+  std::error_code ec;
+  if (options_.source == SourceKind::kReplay &&
+      std::filesystem::weakly_canonical(options_.replay.dataset, ec) == std::filesystem::weakly_canonical(dir, ec)) {
+    spdlog::warn("{}: replaying from the output folder itself; outputs of an earlier run there are overwritten", dir);
+    return;
+  }
+  std::vector<std::string> persistent = {options_.team.store_dir.empty() ? dir + "/exchange" : options_.team.store_dir,
+                                         options_.team.members_file, options_.team.secret_key_file, config_path_};
+  if (options_.source == SourceKind::kReplay) persistent.push_back(options_.replay.dataset);
+  const auto kept = EarlierRuns::Keep(dir, options_.output.keep_runs, persistent);
+  // Not being able to keep them must not keep the robot from running: say so and go on.
+  if (!kept.ok()) {
+    spdlog::error("earlier run's outputs: {}; they may be overwritten", kept.status().ToString());
+    return;
+  }
+  if (!kept->kept_in.empty()) {
+    spdlog::warn("{} outputs of an earlier run moved to {} (a restart never overwrites them)", kept->moved_entries,
+                 kept->kept_in);
+  } else if (kept->moved_entries > 0) {
+    spdlog::info("{} outputs of an earlier run removed (output.keep_runs is 0)", kept->moved_entries);
+  }
+  if (kept->removed_runs > 0) {
+    spdlog::info("{} oldest earlier runs removed to keep {} (output.keep_runs)", kept->removed_runs,
+                 options_.output.keep_runs);
+  }
 }
 
 int Cairnd::Run() {

@@ -19,7 +19,8 @@ class Cairnd {
  public:
   Cairnd(CairndOptions options, std::string config_path);
 
-  // Opens every source and validates its data. Nothing is written before this succeeds.
+  // Opens every source and validates its data. Nothing is written before this succeeds; at its
+  // end an earlier run's outputs in the output folder move to earlier-runs/ (EarlierRuns).
   Status Prepare();
   // Runs until end of data or a termination signal; returns the process exit code. The caller
   // must have blocked SIGTERM and SIGINT in all threads (BlockTerminationSignals) first.
@@ -28,6 +29,8 @@ class Cairnd {
   static void BlockTerminationSignals();
 
  private:
+  // Moves an earlier run's outputs aside (EarlierRuns); a failure is logged, never fatal.
+  void KeepEarlierRun();
   Status WriteOutputs(const struct RunInfo& run, const class Pipeline& pipeline, const class CommsStage* comms);
   // `stem` + .tum / .csv / .kitti (+ _times.txt), for each of output.trajectory_formats.
   Status WriteTrajectory(const std::string& stem, const Trajectory& trajectory) const;

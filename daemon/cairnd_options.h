@@ -62,10 +62,14 @@ struct OutputOptions {
   // Trajectory files, comma separated: tum (.tum), euroc (.csv, EuRoC ground-truth columns),
   // kitti (.kitti, 3x4 matrices, with _times.txt).
   std::string trajectory_formats = "tum";
+  // Outputs a run finds in `dir` from the run before (a restart after a crash) move to
+  // dir/earlier-runs/N; this many such folders stay, the oldest go (0: none are kept).
+  int keep_runs = 10;
 
   void Visit(OptionsVisitor& v) {
     v.Text("dir", dir);
     v.Text("trajectory_formats", trajectory_formats);
+    v.Integer("keep_runs", keep_runs, 0, 1000, "runs");
   }
   Status Validate() const {
     if (dir.empty()) return InvalidArgumentError("dir must not be empty");

@@ -41,7 +41,7 @@ echo "demo: simulating a ${duration} s mission of ${robots[*]} on ${world:-the d
 pids=()
 for i in "${!robots[@]}"; do
   r=${robots[$i]}
-  rm -rf "$out/$r/exchange"  # a new mission: no items of an earlier one
+  rm -rf "${out:?}/$r"  # a new mission: no items or outputs of an earlier one
   "$cairnd" --config "configs/${profiles[$i]}.yaml" "${common[@]}" --set "robot.name=$r" \
     --set "graph.optimizer.own_robot=${letters[$i]}" --set "team.secret_key_file=$team/keys/$r.key" \
     --out "$out/$r" &
@@ -56,6 +56,7 @@ fi
 data="${CAIRN_DATA_DIR:-../shared/data}/euroc-v1_01-micro"
 if [[ -d "$data" ]]; then
   # Dense stereo and mapping on the real pairs too (off in the EuRoC profile, which tests replay).
+  rm -rf "${out:?}/euroc"
   "$cairnd" --config configs/euroc.yaml --replay "$data" --out "$out/euroc" --log-level warn \
     --set stereo.enabled=true --set mapping.enabled=true
 else

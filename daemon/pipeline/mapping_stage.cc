@@ -204,6 +204,9 @@ void MappingStage::Map(const DepthImage& image, const FrameEstimate& e) {
 void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   if (submap == nullptr) return;
   ++report_.submaps_finished;
+  // On disk first: whatever the graph, the exchange or the recording learn of a submap survives a
+  // crash right after.
+  WriteSubmapFile(*submap);
   if (submap_queue_ != nullptr) submap_queue_->TryPush(submap);
   const uint64_t id = submap->metadata().id;
   const auto pose = T_first_frame_.find(id);
@@ -214,9 +217,12 @@ void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   } else {
     Error("submap " + std::to_string(id) + " has no place in the chain of frames; not composed");
   }
+}
+
+void MappingStage::WriteSubmapFile(const Submap& submap) {
   if (!setup_.mapping.write_submaps || setup_.output_dir.empty()) return;
-  const std::string path = setup_.output_dir + "/submaps/" + SubmapFileName(setup_.robot, id);
-  auto bytes = SubmapCodec::Encode(*submap);
+  const std::string path = setup_.output_dir + "/submaps/" + SubmapFileName(setup_.robot, submap.metadata().id);
+  auto bytes = SubmapCodec::Encode(submap);
   Status s = bytes.ok() ? WriteFileAtomically(path, std::string(bytes->begin(), bytes->end())) : bytes.status();
   if (!s.ok()) {
     ++report_.submap_write_failures;
@@ -225,6 +231,7 @@ void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   }
   ++report_.submaps_written;
   report_.submap_bytes += bytes->size();
+  spdlog::debug("submap {} written: {} ({} bytes)", submap.metadata().id, path, bytes->size());
 }
 
 void MappingStage::FinishSubmaps() {

@@ -111,6 +111,8 @@ class MappingStage {
   void Map(const DepthImage& image, const FrameEstimate& e);
   void ApplySwitchesUpTo(uint64_t frame_id);
   void Keep(std::shared_ptr<const Submap> submap);
+  // submaps/ROBOT-NNNNNN.submap, atomically; failures are counted and reported.
+  void WriteSubmapFile(const Submap& submap);
   void PlaceByGraph(const std::map<uint64_t, Eigen::Isometry3d>& origins, const std::vector<PlacedSubmap>* team);
   void Error(const std::string& what);
 
