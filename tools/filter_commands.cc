@@ -38,9 +38,12 @@ void PrintStats(const Timings& t, bool last) {
     if (v.empty()) return 0.0;
     return v[std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size())))];
   };
+  // Which step was the slowest, counted in order: the same step in every run is the filter's own
+  // work (the bench is deterministic), a different one each time is the machine.
+  const size_t max_at = static_cast<size_t>(std::max_element(t.us.begin(), t.us.end()) - t.us.begin());
   std::printf("    \"%s\": {\"count\": %zu, \"mean_us\": %.3f, \"median_us\": %.3f, \"p99_us\": %.3f, "
-              "\"max_us\": %.3f}%s\n",
-              t.name, v.size(), mean, pct(0.5), pct(0.99), v.empty() ? 0.0 : v.back(), last ? "" : ",");
+              "\"max_us\": %.3f, \"max_at\": %zu}%s\n",
+              t.name, v.size(), mean, pct(0.5), pct(0.99), v.empty() ? 0.0 : v.back(), max_at, last ? "" : ",");
 }
 
 struct StallStats {
