@@ -15,6 +15,7 @@
 #include "daemon/submap_index.h"
 #include "daemon/detections_csv.h"
 #include "daemon/earlier_runs.h"
+#include "daemon/heap_policy.h"
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/team_summary.h"
@@ -169,6 +170,7 @@ int Cairnd::Run() {
   run.robot = options_.robot.name;
   run.mode = options_.source == SourceKind::kReplay ? "replay" : options_.source == SourceKind::kSim ? "sim" : "live";
 
+  run.heap_policy = HeapPolicy::Apply(&run.heap_policy_note);
   const ExecutorsOptions& ex = options_.executors;
   if (ex.estimation.realtime || ex.stereo.realtime || ex.mapping.realtime || ex.telemetry.realtime) {
     run.memory_locked = Executor::LockProcessMemory(&run.memory_lock_note);
@@ -384,6 +386,7 @@ int Cairnd::Run() {
     run.extra_executors.push_back(telemetry->executor_report());
   }
   run.complete = finite && run.stop_reason == "end_of_data";
+  run.heap = HeapPolicy::Measure();
   run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (dataset_) {
     run.replay = ReplayInfo{options_.replay.dataset, PacingName(options_.replay.pacing),

@@ -225,6 +225,15 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
   j.Field("wall_time_s", run.wall_time);
   j.Field("memory_locked", run.memory_locked);
   if (!run.memory_lock_note.empty()) j.Field("memory_lock_note", run.memory_lock_note);
+  j.Key("memory").BeginObject();
+  j.Field("heap_policy", run.heap_policy);
+  if (!run.heap_policy_note.empty()) j.Field("heap_policy_note", run.heap_policy_note);
+  j.Field("rss_mb", static_cast<double>(run.heap.rss_bytes) * 1e-6);
+  j.Field("peak_rss_mb", static_cast<double>(run.heap.peak_rss_bytes) * 1e-6);
+  j.Field("heap_in_use_mb", static_cast<double>(run.heap.in_use_bytes) * 1e-6);
+  j.Field("heap_free_retained_mb", static_cast<double>(run.heap.free_retained_bytes) * 1e-6);
+  j.Field("map_composer_mb", static_cast<double>(p.mapping_report().composer_bytes) * 1e-6);
+  j.EndObject();
   j.Key("executors").BeginArray();
   std::vector<ExecutorReport> executors = p.executor_reports();
   executors.insert(executors.end(), run.extra_executors.begin(), run.extra_executors.end());

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "daemon/comms/team_link_status.h"
+#include "daemon/heap_policy.h"
 #include "daemon/pipeline/pipeline.h"
 #include "daemon/pipeline/telemetry_stage.h"
 
@@ -37,6 +38,9 @@ struct RunInfo {
   double wall_time = 0.0;   // s
   bool memory_locked = false;
   std::string memory_lock_note;
+  bool heap_policy = false;  // HeapPolicy applied
+  std::string heap_policy_note;
+  HeapUse heap;              // at the end of the run
 };
 
 std::string BuildSummaryJson(const RunInfo& run, const Pipeline& pipeline);

@@ -53,7 +53,7 @@ std::shared_ptr<const Submap> LocalMapper::FinishAndStart(uint64_t new_frame_id)
     done = open_->Finish();
     ++stats_.submaps_finished;
   }
-  open_ = std::make_unique<OpenSubmap>(options_.submap, robot_, new_frame_id);
+  open_->Restart(new_frame_id);
   return done;
 }
 
@@ -61,7 +61,7 @@ Status LocalMapper::Process(const DepthImage& image, const MappingPose& pose) {
   if (!pose.T_local_body.matrix().allFinite()) return InvalidArgumentError("mapping pose is not finite");
   if (!started_) {
     started_ = true;
-    open_ = std::make_unique<OpenSubmap>(options_.submap, robot_, pose.frame_id);
+    open_->Restart(pose.frame_id);
   } else if (pose.frame_id != open_->metadata().id) {
     // The frame changed without OnFrameSwitch: the transform is unknown, so the rolling map starts
     // over; the submap is finished all the same.

@@ -149,4 +149,14 @@ std::unique_ptr<octomap::OcTree> MapComposer::Octree() const {
   return tree;
 }
 
+size_t MapComposer::memory_bytes() const {
+  size_t n = cloud_.memory_bytes() + occupancy_.memory_bytes() + open_cloud_.memory_bytes() +
+             open_occupancy_.memory_bytes() + open_points_.capacity() * sizeof(CloudPoint) +
+             open_pairs_.capacity() * sizeof(open_pairs_[0]);
+  for (const auto& [ref, e] : entries_) {
+    n += sizeof(e) + e.cloud.capacity() * sizeof(CloudPoint) + e.occupancy.capacity() * sizeof(e.occupancy[0]);
+  }
+  return n;
+}
+
 }  // namespace cairn

@@ -66,6 +66,8 @@ class MapComposer {
   float LogOdds(const Eigen::Vector3d& p) const;
 
   size_t submap_count() const { return entries_.size(); }
+  // Bytes held beyond the submaps themselves: the cached contributions and the composed tables.
+  size_t memory_bytes() const;
 
  private:
   struct Occ {

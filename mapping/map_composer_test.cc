@@ -147,6 +147,19 @@ TEST(MapComposerTest, OpenSubmapIsMergedButNeverCached) {
   EXPECT_TRUE(std::isnan(composer.LogOdds({22.05, 0.05, 0.05})));
 }
 
+TEST(MapComposerTest, MemoryCountsEachSubmapsCachedContribution) {
+  MapComposer composer(CompositionOptions{}, SubmapOptions{});
+  const size_t empty = composer.memory_bytes();
+  const auto s = testing::SyntheticSubmap(0, 3);
+  ASSERT_TRUE(composer.SetSubmap(s, Eigen::Isometry3d::Identity()).ok());
+  composer.Update();
+  // At least the moved copy of its points is cached.
+  EXPECT_GE(composer.memory_bytes(), empty + s->points().size() * sizeof(CloudPoint));
+  composer.RemoveSubmap({s->metadata().robot, s->metadata().id});
+  composer.Update();
+  EXPECT_LT(composer.memory_bytes(), empty + s->points().size() * sizeof(CloudPoint));
+}
+
 TEST(MapComposerTest, RejectsMismatchedResolution) {
   MapComposer composer(CompositionOptions{}, SubmapOptions{});
   SubmapMetadata m;

@@ -30,6 +30,18 @@ OccupancyUpdateStats OpenSubmap::Integrate(const CameraPoints& pts, OccupancyInt
   return integrator->IntegrateCells(pts, cells_, cloud_.inv_resolution(), tree_.get());
 }
 
+void OpenSubmap::Restart(uint64_t id) {
+  if (metadata_.images > 0) {
+    cloud_.Clear();
+    tree_ = MakeOccupancyTree(metadata_.options);
+  }
+  SubmapMetadata fresh;
+  fresh.robot = std::move(metadata_.robot);
+  fresh.id = id;
+  fresh.options = metadata_.options;
+  metadata_ = std::move(fresh);
+}
+
 std::shared_ptr<const Submap> OpenSubmap::Finish() {
   tree_->updateInnerOccupancy();
   tree_->prune();

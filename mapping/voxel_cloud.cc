@@ -11,6 +11,10 @@ VoxelCloud::VoxelCloud(double resolution, size_t expected_voxels)
       voxels_(expected_voxels),
       pending_(size_t{1} << kPendingBits) {}
 
+size_t VoxelCloud::memory_bytes() const {
+  return voxels_.memory_bytes() + keys_.capacity() * sizeof(uint64_t) + pending_.capacity() * sizeof(Pending);
+}
+
 size_t VoxelCloud::size() const {
   size_t n = 0;
   voxels_.ForEach([&](uint64_t, const Accum& a) { n += a.n > 0; });

@@ -24,6 +24,8 @@ class VoxelCloud {
   explicit VoxelCloud(double resolution = 0.05, size_t expected_voxels = 1024);
 
   double resolution() const { return res_; }
+  // Bytes held (table and scratch), for memory reports.
+  size_t memory_bytes() const;
   // Voxels holding points (weight > 0).
   size_t size() const;
   void Clear() { voxels_.Clear(); }

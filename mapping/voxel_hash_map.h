@@ -67,6 +67,7 @@ class VoxelHashMap {
 
   size_t size() const { return size_; }
   bool empty() const { return size_ == 0; }
+  size_t memory_bytes() const { return slots_.capacity() * sizeof(Slot); }
 
   // Keeps the capacity (no allocation when refilled to a similar size).
   void Clear() {

@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/sanitizers.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
@@ -109,6 +110,13 @@ TEST_F(CairndReplayTest, SigtermMidReplayExitsCleanlyWithCompleteOutputs) {
   EXPECT_GT(imu, 0);
   EXPECT_LT(imu, 29120);
   EXPECT_TRUE(fs::exists(out_ + "/diagnostics.json"));
+  // The process's memory at the end, for reading a long mission's growth.
+  const JsonValue m = JsonValue::ParseFile(out_ + "/diagnostics.json")["memory"];
+  EXPECT_EQ(m["heap_policy"].boolean(), !(CAIRN_ADDRESS_SANITIZER || CAIRN_THREAD_SANITIZER));
+  EXPECT_GT(m["rss_mb"].number(), 10.0);
+  EXPECT_GE(m["peak_rss_mb"].number(), m["rss_mb"].number());
+  EXPECT_GT(m["heap_in_use_mb"].number(), 1.0);
+  EXPECT_GE(m["heap_free_retained_mb"].number(), 0.0);
   EXPECT_TRUE(fs::exists(out_ + "/config.yaml"));
   for (const auto& e : fs::directory_iterator(out_)) {
     EXPECT_NE(e.path().extension(), ".tmp") << "half-written file left: " << e.path();
