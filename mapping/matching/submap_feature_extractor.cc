@@ -27,7 +27,11 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
     f.suitability = suitability.Check(submap, f.keypoints.points);
   }
   f.keypoint_ms = MsSince(start);
-  if (!f.suitability.suitable()) return f;
+  if (!f.suitability.suitable()) {
+    // Never aligned, but kept for the whole mission: most submaps of a rover on open ground.
+    f.cloud = std::vector<Eigen::Vector3d>();  // frees it (assigning {} would keep the capacity)
+    return f;
+  }
 
   const auto describe_start = std::chrono::steady_clock::now();
   GravityShotDescriptor descriptor(submap.points(), options_.descriptor);

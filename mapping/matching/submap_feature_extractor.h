@@ -33,7 +33,7 @@ struct SubmapFeatures {
   SuitabilityResult suitability;
   SubmapKeypoints keypoints;
   DescribedKeypoints described;         // empty for an unsuitable submap
-  std::vector<Eigen::Vector3d> cloud;   // finite cloud points, submap frame
+  std::vector<Eigen::Vector3d> cloud;   // finite cloud points, submap frame; empty when unsuitable
   // xy extent of the finite obstacle points (submap frame); empty when there are none.
   Eigen::AlignedBox2d obstacle_box_xy;
   double keypoint_ms = 0.0;    // keypoints, known-space filter and suitability

@@ -221,13 +221,26 @@ TEST(SubmapMatcherSceneTest, NonFinitePointsAreSkipped) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   for (size_t i = 0; i < points.size(); i += 7) points[i].p.x() = (i % 2 == 0) ? nan : inf;
   const size_t broken = (points.size() + 6) / 7;
-  auto tree = MakeOccupancyTree(pair.b->metadata().options);
-  const auto b = std::make_shared<const Submap>(pair.b->metadata(), points, std::move(tree));
+  const auto b = std::make_shared<const Submap>(pair.b->metadata(), points,
+                                                std::make_unique<octomap::OcTree>(pair.b->tree()));
   const SubmapFeatureExtractor extractor;
   const SubmapFeatures fb = extractor.Extract(*b);
   EXPECT_EQ(fb.suitability.non_finite_points, static_cast<int64_t>(broken));
+  ASSERT_TRUE(fb.suitable()) << fb.suitability.message;
   EXPECT_EQ(fb.cloud.size(), points.size() - broken);
   for (const Eigen::Vector3d& p : fb.cloud) ASSERT_TRUE(p.allFinite());
+}
+
+TEST(SubmapMatcherSceneTest, UnsuitableSubmapsKeepNoCloud) {
+  // Without an occupancy tree no keypoint has known space around it.
+  const testing::ScenePair pair = testing::OverlappingSubmaps(7);
+  const auto b = std::make_shared<const Submap>(pair.b->metadata(), pair.b->points(),
+                                                MakeOccupancyTree(pair.b->metadata().options));
+  const SubmapFeatures fb = SubmapFeatureExtractor().Extract(*b);
+  ASSERT_FALSE(fb.suitable());
+  EXPECT_TRUE(fb.cloud.empty());
+  EXPECT_EQ(fb.cloud.capacity(), 0u);
+  EXPECT_FALSE(fb.obstacle_box_xy.isEmpty());  // still pairs by its extent
 }
 
 }  // namespace
