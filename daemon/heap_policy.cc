@@ -3,29 +3,23 @@
 #include <malloc.h>
 
 #include <cstdio>
-#include <cstring>
 
 #include "common/sanitizers.h"
 
 namespace cairn {
 namespace {
 
-// A "VmRSS:   1234 kB" line of /proc/self/status, in bytes; 0 when absent.
-int64_t StatusKilobytes(const char* key) {
+// The "VmRSS:   1234 kB" and "VmHWM: ..." lines of /proc/self/status, in bytes; unset when absent.
+void ReadResidentSet(HeapUse* u) {
   std::FILE* f = std::fopen("/proc/self/status", "r");
-  if (f == nullptr) return 0;
+  if (f == nullptr) return;
   char line[256];
-  int64_t value = 0;
-  const size_t n = std::strlen(key);
+  long long kb = 0;
   while (std::fgets(line, sizeof(line), f) != nullptr) {
-    if (std::strncmp(line, key, n) == 0 && line[n] == ':') {
-      long long kb = 0;
-      if (std::sscanf(line + n + 1, "%lld", &kb) == 1) value = static_cast<int64_t>(kb) * 1024;
-      break;
-    }
+    if (std::sscanf(line, "VmRSS: %lld", &kb) == 1) u->rss_bytes = static_cast<int64_t>(kb) * 1024;
+    if (std::sscanf(line, "VmHWM: %lld", &kb) == 1) u->peak_rss_bytes = static_cast<int64_t>(kb) * 1024;
   }
   std::fclose(f);
-  return value;
 }
 
 }  // namespace
@@ -49,8 +43,7 @@ HeapUse HeapPolicy::Measure() {
   u.in_use_bytes = static_cast<int64_t>(m.uordblks + m.hblkhd);
   u.free_retained_bytes = static_cast<int64_t>(m.fordblks);
   u.mapped_bytes = static_cast<int64_t>(m.hblkhd);
-  u.rss_bytes = StatusKilobytes("VmRSS");
-  u.peak_rss_bytes = StatusKilobytes("VmHWM");
+  ReadResidentSet(&u);
   return u;
 }
 

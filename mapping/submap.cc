@@ -31,7 +31,7 @@ OccupancyUpdateStats OpenSubmap::Integrate(const CameraPoints& pts, OccupancyInt
 }
 
 void OpenSubmap::Restart(uint64_t id) {
-  if (metadata_.images > 0) {
+  if (tree_->size() > 0) {  // not finished (Finish() leaves both empty)
     cloud_.Clear();
     tree_ = MakeOccupancyTree(metadata_.options);
   }
