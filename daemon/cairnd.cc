@@ -387,6 +387,8 @@ int Cairnd::Run() {
   }
   run.complete = finite && run.stop_reason == "end_of_data";
   run.heap = HeapPolicy::Measure();
+  for (const auto& source : sources_) run.simulator_bytes += source->memory_bytes();
+  if (ground_truth_) run.simulator_bytes += ground_truth_->poses.capacity() * sizeof(StampedPose);
   run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (dataset_) {
     run.replay = ReplayInfo{options_.replay.dataset, PacingName(options_.replay.pacing),

@@ -232,7 +232,24 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
   j.Field("peak_rss_mb", static_cast<double>(run.heap.peak_rss_bytes) * 1e-6);
   j.Field("heap_in_use_mb", static_cast<double>(run.heap.in_use_bytes) * 1e-6);
   j.Field("heap_free_retained_mb", static_cast<double>(run.heap.free_retained_bytes) * 1e-6);
-  j.Field("map_composer_mb", static_cast<double>(p.mapping_report().composer_bytes) * 1e-6);
+  // What grows with the mission (the map, the trajectories kept for the outputs, a simulator's
+  // streams), so that the rest (queues, fixed histories, scratch) can be seen to stay bounded.
+  const MappingStageReport& mapping = p.mapping_report();
+  const uint64_t features = p.matching() != nullptr ? p.matching()->report().features_bytes : 0;
+  uint64_t history = p.graph() != nullptr ? p.graph()->report().history_bytes : 0;
+  for (const Trajectory* t : {p.trajectory(), p.odometry()}) history += t != nullptr ? t->poses.capacity() * sizeof(StampedPose) : 0;
+  const uint64_t map_bytes = mapping.composer_bytes + mapping.submaps_memory_bytes + features;
+  j.Field("map_composer_mb", static_cast<double>(mapping.composer_bytes) * 1e-6);
+  j.Field("submaps_mb", static_cast<double>(mapping.submaps_memory_bytes) * 1e-6);
+  j.Field("matcher_features_mb", static_cast<double>(features) * 1e-6);
+  j.Field("map_mb", static_cast<double>(map_bytes) * 1e-6);
+  j.Field("trajectories_mb", static_cast<double>(history) * 1e-6);
+  j.Field("simulator_mb", static_cast<double>(run.simulator_bytes) * 1e-6);
+  // glibc's count; a sanitizer's allocator leaves it at zero, and then there is nothing to subtract from.
+  if (run.heap.in_use_bytes > 0) {
+    j.Field("heap_rest_mb", (static_cast<double>(run.heap.in_use_bytes) -
+                             static_cast<double>(map_bytes + history + run.simulator_bytes)) * 1e-6);
+  }
   j.EndObject();
   j.Key("executors").BeginArray();
   std::vector<ExecutorReport> executors = p.executor_reports();
@@ -262,7 +279,8 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
   for (const LatencyReport& l : p.latency_reports()) {
     j.BeginObject();
     j.Field("stage_input", l.name).Field("count", l.count);
-    j.Field("p50_s", l.p50).Field("p99_s", l.p99).Field("max_s", l.max);
+    j.Field("p50_s", l.p50).Field("p99_s", l.p99).Field("p999_s", l.p999).Field("max_s", l.max);
+    j.Field("over_1ms", l.over_1ms);
     j.EndObject();
   }
   j.EndArray();

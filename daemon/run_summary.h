@@ -41,6 +41,8 @@ struct RunInfo {
   bool heap_policy = false;  // HeapPolicy applied
   std::string heap_policy_note;
   HeapUse heap;              // at the end of the run
+  // Held for the whole run by what is not the robot: the simulator's streams and ground truth.
+  uint64_t simulator_bytes = 0;
 };
 
 std::string BuildSummaryJson(const RunInfo& run, const Pipeline& pipeline);

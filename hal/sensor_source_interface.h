@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "common/status.h"
@@ -20,6 +21,9 @@ class SensorSourceInterface {
   virtual void Stop() = 0;
   // True once a finite source (a replay) has published everything it had.
   virtual bool finished() const = 0;
+  // Heap bytes the source holds for its samples (a simulator's generated streams); devices and
+  // streaming replays hold next to nothing and report 0.
+  virtual size_t memory_bytes() const { return 0; }
 };
 
 }  // namespace cairn

@@ -159,4 +159,10 @@ size_t MapComposer::memory_bytes() const {
   return n;
 }
 
+size_t MapComposer::submap_bytes() const {
+  size_t n = 0;
+  for (const auto& [ref, e] : entries_) n += e.submap != nullptr ? e.submap->memory_bytes() : 0;
+  return n;
+}
+
 }  // namespace cairn

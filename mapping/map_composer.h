@@ -68,6 +68,8 @@ class MapComposer {
   size_t submap_count() const { return entries_.size(); }
   // Bytes held beyond the submaps themselves: the cached contributions and the composed tables.
   size_t memory_bytes() const;
+  // Bytes of the submaps it holds (their clouds and octrees).
+  size_t submap_bytes() const;
 
  private:
   struct Occ {

@@ -155,9 +155,13 @@ TEST(MapComposerTest, MemoryCountsEachSubmapsCachedContribution) {
   composer.Update();
   // At least the moved copy of its points is cached.
   EXPECT_GE(composer.memory_bytes(), empty + s->points().size() * sizeof(CloudPoint));
+  // The submap itself is counted apart: its cloud and every node of its octree.
+  EXPECT_GE(s->memory_bytes(), s->points().size() * sizeof(CloudPoint) + s->tree().size() * sizeof(octomap::OcTreeNode));
+  EXPECT_EQ(composer.submap_bytes(), s->memory_bytes());
   composer.RemoveSubmap({s->metadata().robot, s->metadata().id});
   composer.Update();
   EXPECT_LT(composer.memory_bytes(), empty + s->points().size() * sizeof(CloudPoint));
+  EXPECT_EQ(composer.submap_bytes(), 0u);
 }
 
 TEST(MapComposerTest, RejectsMismatchedResolution) {

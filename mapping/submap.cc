@@ -13,6 +13,10 @@ int64_t Submap::obstacle_points() const {
   return n;
 }
 
+size_t Submap::memory_bytes() const {
+  return sizeof(*this) + points_.capacity() * sizeof(CloudPoint) + (tree_ != nullptr ? tree_->memoryUsage() : 0);
+}
+
 OpenSubmap::OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id)
     : cloud_(options.cloud_resolution, 1 << 16), tree_(MakeOccupancyTree(options)) {
   metadata_.robot = std::move(robot);

@@ -35,6 +35,8 @@ class Submap {
   const std::vector<CloudPoint>& points() const { return points_; }
   const octomap::OcTree& tree() const { return *tree_; }
   int64_t obstacle_points() const;
+  // Heap held: the cloud and the octree (OctoMap's own count of its nodes).
+  size_t memory_bytes() const;
 
  private:
   SubmapMetadata metadata_;

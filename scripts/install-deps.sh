@@ -23,6 +23,8 @@ packages=(
   libapriltag-dev
   # tools used by tests and scripts
   systemd iproute2 can-utils util-linux file python3
+  # cairn bench rt: load on every core, and the machine's own scheduling latency
+  stress-ng rt-tests
   # tests: the real laser scan of ../shared/data/octomap is bzip2-compressed
   libbz2-dev
   # dense stereo (fpga/): Google Highway SIMD

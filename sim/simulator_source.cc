@@ -33,6 +33,8 @@ Status SimulatorSource::Start(SensorSink* sink) {
   if (thread_.joinable()) return FailedPreconditionError(name() + ": already started");
   if (robot_ >= simulator_->robots().size()) return InvalidArgumentError("simulator: no robot " + std::to_string(robot_));
   sink_ = sink;
+  imu_ = simulator_->ImuStream(robot_);
+  if (simulator_->robots()[robot_].kind == SimRobotKind::kRover) can_ = simulator_->WheelStream(robot_);
   clock_.Start(simulator_->start());
   thread_ = std::jthread([this](std::stop_token stop) { Run(stop); });
   return Status::Ok();
@@ -45,13 +47,17 @@ void SimulatorSource::Stop() {
   thread_.join();
 }
 
+size_t SimulatorSource::memory_bytes() const {
+  return imu_.capacity() * sizeof(ImuTruth) + can_.frames.capacity() * sizeof(TimedCanFrame) +
+         can_.reported.capacity() * sizeof(WheelOdometrySample);
+}
+
 void SimulatorSource::Run(std::stop_token stop) {
   const SimRobot& robot = simulator_->robots()[robot_];
   const Timestamp start = simulator_->start();
   const double duration = simulator_->duration();
-  const std::vector<ImuTruth> imu = simulator_->ImuStream(robot_);
-  WheelCanStream can;
-  if (robot.kind == SimRobotKind::kRover) can = simulator_->WheelStream(robot_);
+  const std::vector<ImuTruth>& imu = imu_;
+  const WheelCanStream& can = can_;
   CanWheelDecoder decoder(simulator_->can_layout());
   const int64_t period_ns = std::llround(1e9 / robot.camera_rate_hz);
   const size_t frames = static_cast<size_t>(std::floor(duration * robot.camera_rate_hz + 1e-9)) + 1;

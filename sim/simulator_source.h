@@ -7,6 +7,7 @@
 #include <atomic>
 #include <memory>
 #include <thread>
+#include <vector>
 
 #include "drivers/replay/replay_clock.h"
 #include "drivers/replay/replay_options.h"
@@ -25,9 +26,15 @@ class SimulatorSource final : public SensorSourceInterface {
   Status Start(SensorSink* sink) override;
   void Stop() override;
   bool finished() const override { return finished_.load(std::memory_order_acquire); }
+  // The mission's IMU and CAN streams, generated whole at Start(): they grow with the mission's
+  // duration, which a robot's drivers never do.
+  size_t memory_bytes() const override;
 
  private:
   void Run(std::stop_token stop);
+
+  std::vector<ImuTruth> imu_;
+  WheelCanStream can_;
 
   std::shared_ptr<const MissionSimulator> simulator_;
   size_t robot_;

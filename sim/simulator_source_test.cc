@@ -47,6 +47,8 @@ TEST(SimulatorSourceTest, PublishesTheRoversStreamsInTimeOrder) {
   EXPECT_EQ(sink.stereo.size(), 6u);    // 10 Hz
   EXPECT_EQ(sink.wheel.size(), 51u);    // 100 Hz CAN cycles, decoded
   EXPECT_TRUE(sink.faults.empty());
+  // The whole mission's streams stay held (the daemon reports them apart from its own memory).
+  EXPECT_GE(source.memory_bytes(), 101 * sizeof(ImuTruth) + 51 * sizeof(WheelOdometrySample));
   const auto truth = sim->ImuStream(0);
   for (size_t i = 0; i < sink.imu.size(); ++i) {
     EXPECT_EQ(sink.imu[i].time, truth[i].sample.time);

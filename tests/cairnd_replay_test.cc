@@ -120,6 +120,23 @@ TEST_F(CairndReplayTest, SigtermMidReplayExitsCleanlyWithCompleteOutputs) {
     EXPECT_GT(m["heap_in_use_mb"].number(), 1.0);
   }
   EXPECT_GE(m["heap_free_retained_mb"].number(), 0.0);
+  EXPECT_GE(m["map_mb"].number(), m["map_composer_mb"].number() + m["submaps_mb"].number());
+  EXPECT_GT(m["trajectories_mb"].number(), 0.0);
+  EXPECT_EQ(m["simulator_mb"].number(), 0.0);  // a replay streams its dataset
+  // Real-time pacing: the latency from an IMU sample's arrival to the estimate at it is measured.
+  bool found = false;
+  const JsonValue diagnostics = JsonValue::ParseFile(out_ + "/diagnostics.json");
+  for (const JsonValue& l : diagnostics["latency"].array()) {
+    if (l["stage_input"].string() != "imu_to_estimate") continue;
+    found = true;
+    EXPECT_GT(l["count"].number(), 0);
+    EXPECT_LE(l["count"].number(), imu);
+    EXPECT_GT(l["p50_s"].number(), 0.0);
+    EXPECT_LE(l["p50_s"].number(), l["p999_s"].number());
+    EXPECT_LE(l["p999_s"].number(), l["max_s"].number());
+    EXPECT_LE(l["over_1ms"].number(), l["count"].number());
+  }
+  EXPECT_TRUE(found);
   EXPECT_TRUE(fs::exists(out_ + "/config.yaml"));
   for (const auto& e : fs::directory_iterator(out_)) {
     EXPECT_NE(e.path().extension(), ".tmp") << "half-written file left: " << e.path();

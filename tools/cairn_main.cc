@@ -42,6 +42,7 @@ constexpr auto kCommands = std::to_array<Command>({
     {"bench stereo", "time our SGM against OpenCV StereoSGBM side by side", RunBenchStereo},
     {"bench fpga", "cosimulate one frame on the FPGA SGM core: cycles per pixel, clock, latency", RunBenchFpga},
     {"bench filter", "time the local reference filter (propagation, delayed updates, switches)", RunBenchFilter},
+    {"bench rt", "cairnd's IMU-to-estimate latency under full CPU load, beside cyclictest's", RunBenchRt},
     {"graph solve", "batch-solve a g2o pose graph (file or multi-robot dir) and print costs", RunGraphSolve},
     {"graph replay", "feed a g2o graph vertex by vertex into the online SLAM graph, time each update", RunGraphReplay},
     {"graph inject", "add random false loop closures to a g2o graph (robustness tests)", RunGraphInject},

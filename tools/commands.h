@@ -52,5 +52,6 @@ int RunBenchDetect(const CommandArgs& args);
 int RunDetectBuildLut(const CommandArgs& args);
 int RunDetectCheckLut(const CommandArgs& args);
 int RunBenchMatch(const CommandArgs& args);
+int RunBenchRt(const CommandArgs& args);
 
 }  // namespace cairn::tools

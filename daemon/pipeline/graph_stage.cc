@@ -565,7 +565,14 @@ std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
   return out;
 }
 
-GraphStageReport GraphStage::report() const { return report_; }
+GraphStageReport GraphStage::report() const {
+  GraphStageReport r = report_;
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  r.history_bytes = bytes(estimates_) + bytes(detection_records_);
+  for (const auto& [run, v] : team_estimates_) r.history_bytes += bytes(v);
+  for (const auto& [run, v] : pose_covariances_) r.history_bytes += bytes(v);
+  return r;
+}
 
 std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins() const { return FrameOrigins(robot_); }
 

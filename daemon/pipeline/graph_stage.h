@@ -50,6 +50,9 @@ struct GraphStageReport {
   // (an input was lost upstream). Counted, never guessed.
   uint64_t unplaced = 0;
   uint64_t unconnected_variables = 0;
+  // Trajectories and pose covariances kept for placing sightings and writing the global
+  // trajectory, and the sightings' records: they grow with the mission, like the map.
+  uint64_t history_bytes = 0;
   double chi2 = 0.0;             // after the final solve
   double final_cost = 0.0;
   std::vector<std::string> errors;  // the first few, verbatim

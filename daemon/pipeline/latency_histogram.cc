@@ -19,6 +19,7 @@ void LatencyHistogram::Record(Duration d) {
   const int64_t ns = std::max<int64_t>(0, d.nanoseconds());
   ++buckets_[static_cast<size_t>(Bucket((ns + 999) / 1000))];
   ++count_;
+  if (ns > 1'000'000) ++over_1ms_;
   max_ns_ = std::max(max_ns_, ns);
 }
 

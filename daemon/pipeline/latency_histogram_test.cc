@@ -16,6 +16,11 @@ TEST(LatencyHistogramTest, QuantilesWithinBucketResolution) {
   EXPECT_GE(p99, 990.0);
   EXPECT_LE(p99, 1000.0);  // capped by the exact maximum
   EXPECT_EQ(h.max(), Duration::Microseconds(1000));
+  EXPECT_EQ(h.over_1ms(), 0u);  // 1 ms itself is in time
+  h.Record(Duration::Nanoseconds(1'000'001));
+  h.Record(Duration::Microseconds(1050));
+  EXPECT_EQ(h.over_1ms(), 2u);
+  EXPECT_GE(h.Quantile(0.999).nanoseconds(), 1'000'000);
 }
 
 TEST(LatencyHistogramTest, EmptyAndExtremes) {

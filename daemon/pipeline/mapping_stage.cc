@@ -251,6 +251,7 @@ void MappingStage::Finish(const std::map<uint64_t, Eigen::Isometry3d>* graph_ori
   const std::unique_ptr<octomap::OcTree> tree = composer_.Octree();
   report_.map_points = cloud.size();
   report_.composer_bytes = composer_.memory_bytes();
+  report_.submaps_memory_bytes = composer_.submap_bytes();
   report_.map_voxels = tree ? tree->getNumLeafNodes() : 0;
   if (!setup_.mapping.write_map || setup_.output_dir.empty() || report_.submaps_finished == 0) return;
   const std::string& dir = setup_.output_dir;

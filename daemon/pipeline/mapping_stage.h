@@ -69,6 +69,7 @@ struct MappingStageReport {
   uint64_t map_points = 0;           // composed cloud at the end
   uint64_t map_voxels = 0;           // composed occupancy voxels at the end
   uint64_t submaps_placed_by_graph = 0;  // composed at the SLAM graph's origins
+  uint64_t submaps_memory_bytes = 0;  // clouds and octrees of every submap composed at the end
   uint64_t composer_bytes = 0;  // the composer's cache and tables at the end (MapComposer::memory_bytes)
   uint64_t team_submaps = 0;            // teammates' submaps composed into the map
   LocalMapperStats mapper;

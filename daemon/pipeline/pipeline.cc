@@ -322,7 +322,10 @@ void Pipeline::EstimationLoop(std::stop_token stop) {
           imu_latency_.Record(latency);
           if (latency > imu_deadline_) deadline_misses_.fetch_add(1, std::memory_order_relaxed);
           imu_stats_.Add(imu.value.time);
-          if (estimation_) estimation_->OnImu(imu.value);
+          if (estimation_) {
+            estimation_->OnImu(imu.value);
+            imu_to_estimate_.Record(Duration::Nanoseconds(MonotonicNs() - imu.enqueued_ns));
+          }
           if (telemetry_ != nullptr) telemetry_->OfferImu(imu.value);
           // Live mode: wake mapping when an estimate it waits for came out (deterministic replays
           // map at fixed points of the data flow instead, see MappingLoop).
@@ -674,9 +677,16 @@ uint64_t Pipeline::total_dropped() const {
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {
   const auto r = [](const char* name, const LatencyHistogram& h) {
-    return LatencyReport{name, h.count(), h.Quantile(0.5).seconds(), h.Quantile(0.99).seconds(), h.max().seconds()};
+    return LatencyReport{name,
+                         h.count(),
+                         h.Quantile(0.5).seconds(),
+                         h.Quantile(0.99).seconds(),
+                         h.Quantile(0.999).seconds(),
+                         h.max().seconds(),
+                         h.over_1ms()};
   };
-  return {r("imu", imu_latency_), r("wheel_odometry", wheel_latency_), r("stereo", stereo_latency_)};
+  return {r("imu", imu_latency_), r("imu_to_estimate", imu_to_estimate_), r("wheel_odometry", wheel_latency_),
+          r("stereo", stereo_latency_)};
 }
 
 std::vector<ExecutorReport> Pipeline::executor_reports() const {

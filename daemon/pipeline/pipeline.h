@@ -57,11 +57,13 @@ struct FaultReport {
   std::vector<std::string> first_messages;                         // the first few, verbatim
 };
 
-// Time from publication to consumption by the stage, on the monotonic wall clock.
+// Time from publication to consumption by the stage, on the monotonic wall clock
+// ("imu_to_estimate": from publication of an IMU sample to the filter's estimate at it).
 struct LatencyReport {
   std::string name;
   uint64_t count = 0;
-  double p50 = 0.0, p99 = 0.0, max = 0.0;  // s
+  double p50 = 0.0, p99 = 0.0, p999 = 0.0, max = 0.0;  // s
+  uint64_t over_1ms = 0;
 };
 
 struct StereoStageReport {
@@ -254,6 +256,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   SensorStreamStats wheel_stats_;
   SensorStreamStats trigger_stats_;
   LatencyHistogram imu_latency_, wheel_latency_;
+  LatencyHistogram imu_to_estimate_;  // IMU sample published -> filter propagated to it
   // Owned by the stereo thread until joined.
   LatencyHistogram stereo_latency_;
   SensorStreamStats stereo_stats_;

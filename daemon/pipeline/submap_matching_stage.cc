@@ -268,6 +268,7 @@ SubmapMatchingReport SubmapMatchingStage::report() const {
   r.features_ms_max = features_time_.max().seconds() * 1e3;
   r.match_ms_p50 = match_time_.Quantile(0.5).seconds() * 1e3;
   r.match_ms_max = match_time_.max().seconds() * 1e3;
+  for (const auto& [key, f] : features_) r.features_bytes += f->memory_bytes();
   for (const auto& [skip, count] : pairing_.Census())
     r.pairs.emplace_back(std::string(skip == PairSkip::kNone ? "not yet attempted" : PairSkipName(skip)), count);
   return r;

@@ -49,6 +49,7 @@ struct SubmapMatchingReport {
   uint64_t jobs_waiting_max = 0;  // high water of the pool's queue
   double features_ms_p50 = 0.0, features_ms_max = 0.0;
   double match_ms_p50 = 0.0, match_ms_max = 0.0;
+  uint64_t features_bytes = 0;  // what the kept features of every submap hold
   std::vector<std::string> errors;  // the first few, verbatim
   // Every pair of this robot's submaps at the end, by why it was or was not attempted.
   std::vector<std::pair<std::string, uint64_t>> pairs;

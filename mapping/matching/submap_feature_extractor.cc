@@ -11,6 +11,12 @@ double MsSince(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+size_t SubmapFeatures::memory_bytes() const {
+  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return sizeof(*this) + bytes(keypoints.points) + bytes(keypoints.known_fraction) + bytes(described.points) +
+         bytes(described.descriptors) + bytes(described.frames) + bytes(described.keypoint_index) + bytes(cloud);
+}
+
 SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   SubmapFeatures f;
   const auto start = std::chrono::steady_clock::now();

@@ -40,6 +40,7 @@ struct SubmapFeatures {
   double descriptor_ms = 0.0;  // descriptors (zero for an unsuitable submap)
 
   bool suitable() const { return suitability.suitable(); }
+  size_t memory_bytes() const;  // heap held by the vectors above
 };
 
 class SubmapFeatureExtractor {

@@ -241,6 +241,11 @@ TEST(SubmapMatcherSceneTest, UnsuitableSubmapsKeepNoCloud) {
   EXPECT_TRUE(fb.cloud.empty());
   EXPECT_EQ(fb.cloud.capacity(), 0u);
   EXPECT_FALSE(fb.obstacle_box_xy.isEmpty());  // still pairs by its extent
+  // A suitable submap's features hold its cloud and descriptors; this one holds next to nothing.
+  const SubmapFeatures fa = SubmapFeatureExtractor().Extract(*pair.a);
+  ASSERT_TRUE(fa.suitable()) << fa.suitability.message;
+  EXPECT_GE(fa.memory_bytes(), fa.cloud.size() * sizeof(Eigen::Vector3d) + fa.described.descriptors.size() * sizeof(GravityShot));
+  EXPECT_LT(fb.memory_bytes(), fa.memory_bytes() / 10);
 }
 
 }  // namespace
