@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "common/atomic_file.h"
+#include "common/heap_bytes.h"
 #include "common/options_yaml_writer.h"
 #include "daemon/comms/comms_stage.h"
 #include "daemon/pipeline/pipeline.h"
@@ -388,7 +389,7 @@ int Cairnd::Run() {
   run.complete = finite && run.stop_reason == "end_of_data";
   run.heap = HeapPolicy::Measure();
   for (const auto& source : sources_) run.simulator_bytes += source->memory_bytes();
-  if (ground_truth_) run.simulator_bytes += ground_truth_->poses.capacity() * sizeof(StampedPose);
+  if (ground_truth_) run.simulator_bytes += HeapBytes(ground_truth_->poses);
   run.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (dataset_) {
     run.replay = ReplayInfo{options_.replay.dataset, PacingName(options_.replay.pacing),

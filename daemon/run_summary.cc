@@ -1,5 +1,6 @@
 #include "daemon/run_summary.h"
 
+#include "common/heap_bytes.h"
 #include "common/json_writer.h"
 
 #include <filesystem>
@@ -237,7 +238,7 @@ std::string BuildDiagnosticsJson(const RunInfo& run, const Pipeline& p) {
   const MappingStageReport& mapping = p.mapping_report();
   const uint64_t features = p.matching() != nullptr ? p.matching()->report().features_bytes : 0;
   uint64_t history = p.graph() != nullptr ? p.graph()->report().history_bytes : 0;
-  for (const Trajectory* t : {p.trajectory(), p.odometry()}) history += t != nullptr ? t->poses.capacity() * sizeof(StampedPose) : 0;
+  for (const Trajectory* t : {p.trajectory(), p.odometry()}) history += t != nullptr ? HeapBytes(t->poses) : 0;
   const uint64_t map_bytes = mapping.composer_bytes + mapping.submaps_memory_bytes + features;
   j.Field("map_composer_mb", static_cast<double>(mapping.composer_bytes) * 1e-6);
   j.Field("submaps_mb", static_cast<double>(mapping.submaps_memory_bytes) * 1e-6);

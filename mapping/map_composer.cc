@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 
+#include "common/heap_bytes.h"
 #include "mapping/occupancy_integrator.h"
 
 namespace cairn {
@@ -151,10 +152,9 @@ std::unique_ptr<octomap::OcTree> MapComposer::Octree() const {
 
 size_t MapComposer::memory_bytes() const {
   size_t n = cloud_.memory_bytes() + occupancy_.memory_bytes() + open_cloud_.memory_bytes() +
-             open_occupancy_.memory_bytes() + open_points_.capacity() * sizeof(CloudPoint) +
-             open_pairs_.capacity() * sizeof(open_pairs_[0]);
+             open_occupancy_.memory_bytes() + HeapBytes(open_points_, open_pairs_);
   for (const auto& [ref, e] : entries_) {
-    n += sizeof(e) + e.cloud.capacity() * sizeof(CloudPoint) + e.occupancy.capacity() * sizeof(e.occupancy[0]);
+    n += sizeof(e) + HeapBytes(e.cloud, e.occupancy);
   }
   return n;
 }

@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "common/heap_bytes.h"
+
 namespace cairn {
 
 Submap::Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree)
@@ -14,7 +16,7 @@ int64_t Submap::obstacle_points() const {
 }
 
 size_t Submap::memory_bytes() const {
-  return sizeof(*this) + points_.capacity() * sizeof(CloudPoint) + (tree_ != nullptr ? tree_->memoryUsage() : 0);
+  return sizeof(*this) + HeapBytes(points_) + (tree_ != nullptr ? tree_->memoryUsage() : 0);
 }
 
 OpenSubmap::OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id)

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "common/heap_bytes.h"
 #include "drivers/can_wheel_decoder.h"
 #include "sim/imu_synthesizer.h"
 #include "sim/wheel_can_encoder.h"
@@ -48,8 +49,7 @@ void SimulatorSource::Stop() {
 }
 
 size_t SimulatorSource::memory_bytes() const {
-  return imu_.capacity() * sizeof(ImuTruth) + can_.frames.capacity() * sizeof(TimedCanFrame) +
-         can_.reported.capacity() * sizeof(WheelOdometrySample);
+  return HeapBytes(imu_, can_.frames, can_.reported);
 }
 
 void SimulatorSource::Run(std::stop_token stop) {

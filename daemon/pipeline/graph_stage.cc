@@ -6,6 +6,7 @@
 #include <numbers>
 #include <set>
 
+#include "common/heap_bytes.h"
 #include "common/monotonic_clock.h"
 #include "detection/gravity_agreement.h"
 
@@ -567,10 +568,9 @@ std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
 
 GraphStageReport GraphStage::report() const {
   GraphStageReport r = report_;
-  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  r.history_bytes = bytes(estimates_) + bytes(detection_records_);
-  for (const auto& [run, v] : team_estimates_) r.history_bytes += bytes(v);
-  for (const auto& [run, v] : pose_covariances_) r.history_bytes += bytes(v);
+  r.history_bytes = HeapBytes(estimates_, detection_records_);
+  for (const auto& [run, v] : team_estimates_) r.history_bytes += HeapBytes(v);
+  for (const auto& [run, v] : pose_covariances_) r.history_bytes += HeapBytes(v);
   return r;
 }
 

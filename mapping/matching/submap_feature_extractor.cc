@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "common/heap_bytes.h"
+
 namespace cairn {
 namespace {
 
@@ -12,9 +14,8 @@ double MsSince(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 size_t SubmapFeatures::memory_bytes() const {
-  const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return sizeof(*this) + bytes(keypoints.points) + bytes(keypoints.known_fraction) + bytes(described.points) +
-         bytes(described.descriptors) + bytes(described.frames) + bytes(described.keypoint_index) + bytes(cloud);
+  return sizeof(*this) + HeapBytes(keypoints.points, keypoints.known_fraction, described.points, described.descriptors,
+                                   described.frames, described.keypoint_index, cloud);
 }
 
 SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
