@@ -146,12 +146,16 @@ int RunBenchRt(const CommandArgs& args) {
       return 1;
     }
   }
+  // Only what this command writes is replaced: --out may name a folder that holds other things,
+  // and cairnd keeps its own earlier outputs in OUT/cairnd/earlier-runs.
   std::error_code ec;
-  fs::remove_all(b.out, ec);
   fs::create_directories(b.out, ec);
   if (ec) {
     std::fprintf(stderr, "cairn bench rt: cannot create %s: %s\n", b.out.c_str(), ec.message().c_str());
     return 1;
+  }
+  for (const char* own : {"cyclictest.json", "cyclictest.log", "stress-ng.log", "cairnd.log", "bench_rt.json"}) {
+    fs::remove(fs::path(b.out) / own, ec);
   }
   const std::string secs = std::to_string(static_cast<long>(std::lround(b.seconds)));
   // The machine's own latency, measured the way our thread is scheduled: same policy, priority
