@@ -21,6 +21,9 @@ endfunction()
 # standard library, Eigen's Core and Geometry and, for tests, GoogleTest are parsed once per build
 # instead of once per file. Builds without it (release, cross) keep every file's own includes
 # honest. cairn_define_pch() makes the two header-only targets the others reuse.
+# The same presets also build in unity batches of eight files (CMAKE_UNITY_BUILD), which parse
+# Ceres', OpenCV's and GoogleTest's headers once per batch: names local to a file (anonymous
+# namespaces) must therefore be unique within their target; shared constants live in headers.
 function(cairn_define_pch)
   if(NOT CAIRN_PCH)
     return()

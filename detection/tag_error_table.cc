@@ -7,10 +7,11 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/angles.h"
+
 namespace cairn {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr const char* kMagic = "cairn-tag-error-table";
 
 std::string Where(const std::string& source, int line) { return source + ":" + std::to_string(line); }
@@ -87,8 +88,8 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
         double a0 = 0.0, a1 = 0.0;
         ok = static_cast<bool>(words >> a0 >> a1 >> t.na_) && a0 >= 0.0 && a1 > a0 && a1 < 90.0 && t.na_ >= 2 &&
              t.na_ <= 10000;
-        t.a0_ = a0 * kDeg;
-        t.a1_ = a1 * kDeg;
+        t.a0_ = a0 * kDegree;
+        t.a1_ = a1 * kDegree;
         angles = true;
       } else {
         return InvalidArgumentError(at + ": '" + key +
@@ -109,10 +110,10 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
     std::string extra;
     if (!ok || (values >> extra)) return InvalidArgumentError(at + ": a row needs 10 numbers");
     const int i = static_cast<int>(row) / t.na_, j = static_cast<int>(row) % t.na_;
-    if (std::abs(d - t.distance_at(i)) > 1e-3 * std::max(1.0, d) || std::abs(a * kDeg - t.angle_at(j)) > 1e-3)
+    if (std::abs(d - t.distance_at(i)) > 1e-3 * std::max(1.0, d) || std::abs(a * kDegree - t.angle_at(j)) > 1e-3)
       return InvalidArgumentError(at + ": row for distance " + std::to_string(d) + " m, angle " + std::to_string(a) +
                                   " deg is out of order (expected " + std::to_string(t.distance_at(i)) + ", " +
-                                  std::to_string(t.angle_at(j) / kDeg) + ")");
+                                  std::to_string(t.angle_at(j) / kDegree) + ")");
     if (c.rendered < 0 || c.detected < 0 || c.detected > c.rendered)
       return InvalidArgumentError(at + ": counts must satisfy 0 <= detected <= rendered");
     for (int k = 0; k < 6; ++k) {
@@ -138,14 +139,14 @@ std::string TagErrorTable::Serialize() const {
   std::snprintf(buf, sizeof buf, "camera %s %d %d %.6g %.6g\ntag_size %.6g\ncorner_rms %.4f\n", camera_.c_str(), width_,
                 height_, fx_, fy_, tag_size_, corner_rms_);
   out += buf;
-  std::snprintf(buf, sizeof buf, "distances %.6g %.6g %d\nangles %.6g %.6g %d\n", d0_, d1_, nd_, a0_ / kDeg, a1_ / kDeg, na_);
+  std::snprintf(buf, sizeof buf, "distances %.6g %.6g %d\nangles %.6g %.6g %d\n", d0_, d1_, nd_, a0_ / kDegree, a1_ / kDegree, na_);
   out += buf;
   out += "# distance_m angle_deg rendered detected sigma_x_m sigma_y_m sigma_z_m sigma_rx_rad sigma_ry_rad sigma_rz_rad\n";
   for (int i = 0; i < nd_; ++i) {
     for (int j = 0; j < na_; ++j) {
       const TagErrorCell& c = cell(i, j);
       std::snprintf(buf, sizeof buf, "%.4f %.3f %d %d %.4e %.4e %.4e %.4e %.4e %.4e\n", distance_at(i),
-                    angle_at(j) / kDeg, c.rendered, c.detected, c.sigma[0], c.sigma[1], c.sigma[2], c.sigma[3],
+                    angle_at(j) / kDegree, c.rendered, c.detected, c.sigma[0], c.sigma[1], c.sigma[2], c.sigma[3],
                     c.sigma[4], c.sigma[5]);
       out += buf;
     }

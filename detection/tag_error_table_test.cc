@@ -7,16 +7,15 @@
 
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 // 3 distances (1, 2, 3 m) x 3 angles (0, 30, 60 deg); sigma k of cell (i, j) = (k + 1) * (i + 1) * 0.01 + j * 0.001.
 TagErrorTable Grid() {
-  TagErrorTable t("rover", 1024, 508, 1080.0, 1080.0, 0.16, 1.0, 3.0, 3, 0.0, 60 * kDeg, 3);
+  TagErrorTable t("rover", 1024, 508, 1080.0, 1080.0, 0.16, 1.0, 3.0, 3, 0.0, 60 * kDegree, 3);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
       TagErrorCell& c = t.cell(i, j);
@@ -29,11 +28,11 @@ TagErrorTable Grid() {
 
 TEST(TagErrorTableTest, LooksUpBilinearlyAndScalesWithTheTagSize) {
   const TagErrorTable t = Grid();
-  EXPECT_NEAR(t.Sigma(2.0, 30 * kDeg, 0.16)[0], 0.021, 1e-12);
-  EXPECT_NEAR(t.Sigma(1.5, 15 * kDeg, 0.16)[1], 2 * 1.5 * 0.01 + 0.0005, 1e-12);
+  EXPECT_NEAR(t.Sigma(2.0, 30 * kDegree, 0.16)[0], 0.021, 1e-12);
+  EXPECT_NEAR(t.Sigma(1.5, 15 * kDegree, 0.16)[1], 2 * 1.5 * 0.01 + 0.0005, 1e-12);
   // Negative angles look like positive ones; beyond the last angle the edge holds.
-  EXPECT_NEAR(t.Sigma(2.0, -30 * kDeg, 0.16)[0], 0.021, 1e-12);
-  EXPECT_NEAR(t.Sigma(2.0, 85 * kDeg, 0.16)[0], 0.022, 1e-12);
+  EXPECT_NEAR(t.Sigma(2.0, -30 * kDegree, 0.16)[0], 0.021, 1e-12);
+  EXPECT_NEAR(t.Sigma(2.0, 85 * kDegree, 0.16)[0], 0.022, 1e-12);
   // A tag twice the size at twice the distance is the same picture, with translations doubled.
   const auto small = t.Sigma(1.0, 0.0, 0.16), big = t.Sigma(2.0, 0.0, 0.32);
   EXPECT_NEAR(big[2], 2.0 * small[2], 1e-12);
@@ -57,7 +56,7 @@ TEST(TagErrorTableTest, SerializesAndParsesBackTheSameTable) {
   EXPECT_NEAR(back->corner_rms(), 0.12, 1e-9);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) EXPECT_NEAR(back->cell(i, j).sigma[4], t.cell(i, j).sigma[4], 1e-5);
-  EXPECT_NEAR(back->Sigma(1.7, 20 * kDeg, 0.2)[3], t.Sigma(1.7, 20 * kDeg, 0.2)[3], 1e-5);
+  EXPECT_NEAR(back->Sigma(1.7, 20 * kDegree, 0.2)[3], t.Sigma(1.7, 20 * kDegree, 0.2)[3], 1e-5);
 }
 
 TEST(TagErrorTableTest, MalformedFilesNameTheLine) {
@@ -98,7 +97,7 @@ TEST(TagErrorTableTest, MalformedFilesNameTheLine) {
 }
 
 TEST(TagErrorTableTest, FillsUndetectedCellsFromTheirNeighboursAndRemovesOutliers) {
-  TagErrorTable t("rover", 1024, 508, 1080.0, 1080.0, 0.16, 1.0, 5.0, 5, 0.0, 80 * kDeg, 5);
+  TagErrorTable t("rover", 1024, 508, 1080.0, 1080.0, 0.16, 1.0, 5.0, 5, 0.0, 80 * kDegree, 5);
   for (int i = 0; i < 5; ++i)
     for (int j = 0; j < 5; ++j) {
       TagErrorCell& c = t.cell(i, j);

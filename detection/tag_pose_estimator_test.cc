@@ -7,13 +7,13 @@
 
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "detection/tag_detector.h"
 #include "detection/testing/rendered_tag.h"
 
 namespace cairn {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 const PinholeRadTan kCamera{1024, 508, 1080.0, 1080.0, 512.0, 254.0};  // the rover's, rectified
 
 // A tag `distance` ahead, turned by `tilt` about the camera's x axis (0: facing the camera).
@@ -34,7 +34,7 @@ std::array<Eigen::Vector2d, 4> Project(const Eigen::Isometry3d& T_cam_tag, doubl
 }
 
 TEST(TagPoseEstimatorTest, ExactCornersGiveTheExactPose) {
-  const Eigen::Isometry3d truth = TagAt(2.0, 35 * kDeg);
+  const Eigen::Isometry3d truth = TagAt(2.0, 35 * kDegree);
   const auto pose = TagPoseEstimator().Estimate(Project(truth, 0.16), kCamera);
   ASSERT_TRUE(pose.ok()) << pose.status().ToString();
   EXPECT_LT(TagPoseEstimator::Deviation(truth, pose->T_cam_tag).norm(), 1e-6);
@@ -48,11 +48,11 @@ TEST(TagPoseEstimatorTest, SigmasGrowWithDistanceAndDepthIsTheWeakAxis) {
   const TagPoseEstimator estimator;
   double previous_depth_sigma = 0.0;
   for (const double d : {1.0, 2.0, 4.0, 8.0}) {
-    const auto pose = estimator.Estimate(Project(TagAt(d, 20 * kDeg), 0.16), kCamera);
+    const auto pose = estimator.Estimate(Project(TagAt(d, 20 * kDegree), 0.16), kCamera);
     ASSERT_TRUE(pose.ok());
     const Eigen::Matrix<double, 6, 1> sigma = pose->covariance.diagonal().cwiseSqrt();
     std::printf("[ tagpose ] %.0f m: sigma x y z %.4f %.4f %.4f m, rotation %.2f %.2f %.2f deg, %d flipped\n", d,
-                sigma[0], sigma[1], sigma[2], sigma[3] / kDeg, sigma[4] / kDeg, sigma[5] / kDeg,
+                sigma[0], sigma[1], sigma[2], sigma[3] / kDegree, sigma[4] / kDegree, sigma[5] / kDegree,
                 pose->flipped_samples);
     // Depth (along the line of sight, about the tag's z here) is the least certain translation.
     EXPECT_GT(sigma[2], sigma[0]);
@@ -69,12 +69,12 @@ TEST(TagPoseEstimatorTest, RenderedTagsAreFoundWhereTheyAreWithinTheirSigmas) {
   int cases = 0;
   double nees = 0.0;
   for (const double d : {1.0, 2.5, 4.0}) {
-    for (const double tilt : {-50 * kDeg, -20 * kDeg, 10 * kDeg, 40 * kDeg}) {
+    for (const double tilt : {-50 * kDegree, -20 * kDegree, 10 * kDegree, 40 * kDegree}) {
       const Eigen::Isometry3d truth = TagAt(d, tilt, {0.2, 0.1});
       const cv::Mat image = testing::RenderTag(5, 0.16, truth, kCamera);
       const auto found = detector.Detect(testing::ImageOf(image));
       ASSERT_TRUE(found.ok());
-      ASSERT_EQ(found->size(), 1u) << d << " m, " << tilt / kDeg << " deg";
+      ASSERT_EQ(found->size(), 1u) << d << " m, " << tilt / kDegree << " deg";
       EXPECT_EQ((*found)[0].id, 5);
       // The detector's corners lie on the projected ones, in the estimator's order.
       const auto projected = Project(truth, 0.16);
@@ -84,8 +84,8 @@ TEST(TagPoseEstimatorTest, RenderedTagsAreFoundWhereTheyAreWithinTheirSigmas) {
       const Eigen::Matrix<double, 6, 1> e = TagPoseEstimator::Deviation(pose->T_cam_tag, truth);
       const Eigen::Matrix<double, 6, 1> sigma = pose->covariance.diagonal().cwiseSqrt();
       std::printf("[ tagpose ] rendered %.1f m %+.0f deg: error %.4f m %.2f deg; 3 sigma %.4f m %.2f deg\n", d,
-                  tilt / kDeg, e.head<3>().norm(), e.tail<3>().norm() / kDeg, 3 * sigma.head<3>().norm(),
-                  3 * sigma.tail<3>().norm() / kDeg);
+                  tilt / kDegree, e.head<3>().norm(), e.tail<3>().norm() / kDegree, 3 * sigma.head<3>().norm(),
+                  3 * sigma.tail<3>().norm() / kDegree);
       for (int k = 0; k < 6; ++k) EXPECT_LT(std::abs(e[k]), 3.0 * sigma[k]) << d << " m, axis " << k;
       nees += e.dot(pose->covariance.inverse() * e);
       ++cases;

@@ -19,7 +19,7 @@ namespace cairn {
 namespace {
 
 // The pair every test here matches.
-TestStereoPair Frame() { return TestStereoPair::Make(40, 12, 4, 9); }
+TestStereoPair MatcherTestPair() { return TestStereoPair::Make(40, 12, 4, 9); }
 
 std::vector<int16_t> Golden(const TestStereoPair& f) {
   auto m = SgmMatcher::Create(FpgaModeTestOptions());
@@ -100,7 +100,7 @@ TEST(FpgaStereoMatcherTest, RejectsOptionsTheCoreCannotRun) {
 }
 
 TEST(FpgaStereoMatcherTest, DmaReadFaultIsReportedAndTheNextFrameWorks) {
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = MatcherTestPair();
   SimulatedStereoDevice* dev = nullptr;
   auto m = OnSimulator(&dev, std::chrono::milliseconds(50));
   ASSERT_NE(m, nullptr);
@@ -114,7 +114,7 @@ TEST(FpgaStereoMatcherTest, DmaReadFaultIsReportedAndTheNextFrameWorks) {
 }
 
 TEST(FpgaStereoMatcherTest, HungBusTimesOutAndAbortRecovers) {
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = MatcherTestPair();
   SimulatedStereoDevice* dev = nullptr;
   auto m = OnSimulator(&dev, std::chrono::microseconds(200));  // 30000 simulated cycles
   ASSERT_NE(m, nullptr);
@@ -129,7 +129,7 @@ TEST(FpgaStereoMatcherTest, HungBusTimesOutAndAbortRecovers) {
 }
 
 TEST(FpgaStereoMatcherTest, RemovalMidFrameIsReported) {
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = MatcherTestPair();
   SimulatedStereoDevice* dev = nullptr;
   auto m = OnSimulator(&dev, std::chrono::milliseconds(50));
   ASSERT_NE(m, nullptr);

@@ -15,7 +15,7 @@ namespace cairn {
 namespace {
 
 // The pair every test here matches.
-TestStereoPair Frame() { return TestStereoPair::Make(36, 10, 6, 17); }
+TestStereoPair SwitchTestPair() { return TestStereoPair::Make(36, 10, 6, 17); }
 
 StereoBackendOptions Backend(StereoBackend b) {
   StereoBackendOptions o;
@@ -54,7 +54,7 @@ TEST(StereoBackendSwitchTest, CpuNeverOpensTheDevice) {
   ASSERT_TRUE(s.ok());
   EXPECT_FALSE(opened);
   EXPECT_FALSE((*s)->fpga_active());
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = SwitchTestPair();
   StereoMatcherOutput out;
   ASSERT_TRUE((*s)->Match(f.input(), &out).ok());
   EXPECT_EQ((*s)->cpu_frames(), 1u);
@@ -62,7 +62,7 @@ TEST(StereoBackendSwitchTest, CpuNeverOpensTheDevice) {
 }
 
 TEST(StereoBackendSwitchTest, FpgaAndAutoUseThePresentDeviceWithTheCpuResult) {
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = SwitchTestPair();
   for (StereoBackend b : {StereoBackend::kFpga, StereoBackend::kAuto}) {
     auto s = StereoBackendSwitch::Create(Backend(b), FpgaModeTestOptions(), Simulated());
     ASSERT_TRUE(s.ok()) << s.status().ToString();
@@ -76,7 +76,7 @@ TEST(StereoBackendSwitchTest, FpgaAndAutoUseThePresentDeviceWithTheCpuResult) {
 }
 
 TEST(StereoBackendSwitchTest, AbsentDeviceFallsBackWithOneWarningOnlyWhenAskedFor) {
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = SwitchTestPair();
   std::vector<std::string> warnings;
   const auto warn = [&warnings](const std::string& m) { warnings.push_back(m); };
   auto fpga = StereoBackendSwitch::Create(Backend(StereoBackend::kFpga), FpgaModeTestOptions(), Absent(), warn);
@@ -110,7 +110,7 @@ TEST(StereoBackendSwitchTest, OptionsTheCoreCannotRun) {
 }
 
 TEST(StereoBackendSwitchTest, FailureMidRunSwitchesToTheCpuOnceAndKeepsRunning) {
-  const TestStereoPair f = Frame();
+  const TestStereoPair f = SwitchTestPair();
   const auto golden = Cpu(f);
   std::vector<std::string> warnings;
   SimulatedStereoDevice* dev = nullptr;

@@ -7,7 +7,7 @@
 namespace cairn::sim {
 namespace {
 
-WorldOptions SmallWorld() {
+WorldOptions RenderWorld() {
   WorldOptions w;
   w.size = 24.0;
   w.seed = 4;
@@ -39,7 +39,7 @@ Eigen::Isometry3d LookingForwardDown(const Terrain& t, double x, double y, doubl
 // Every rendered depth, back-projected, lies on the terrain, and the ray to it stays above the
 // terrain: the image's depth is the ray-cast ground truth.
 TEST(CameraRendererTest, RenderedDepthIsTheTerrainGroundTruth) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(RenderWorld());
   RenderScene scene;
   scene.terrain = &terrain;
   const PinholeRadTan k = SmallCamera();
@@ -70,7 +70,7 @@ TEST(CameraRendererTest, RenderedDepthIsTheTerrainGroundTruth) {
 // the image of the vertical, or from the tile bounds): every rendered depth is that of the plain
 // ray cast from the camera, and the pixels without depth are the ones whose ray misses.
 TEST(CameraRendererTest, FullSizeCamerasShowTheFirstHitOfEveryRay) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(RenderWorld());
   RenderScene scene;
   scene.terrain = &terrain;
   struct View {
@@ -113,7 +113,7 @@ TEST(CameraRendererTest, FullSizeCamerasShowTheFirstHitOfEveryRay) {
 }
 
 TEST(CameraRendererTest, SameSeedSameImageAndNoiseDependsOnSeed) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(RenderWorld());
   RenderScene scene;
   scene.terrain = &terrain;
   const Eigen::Isometry3d T = LookingForwardDown(terrain, 0, 0, 1.3);
@@ -131,7 +131,7 @@ TEST(CameraRendererTest, SameSeedSameImageAndNoiseDependsOnSeed) {
 
 // A marker facing the camera shows its black border and its data bits.
 TEST(CameraRendererTest, MarkerFacingTheCameraShowsItsBits) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(RenderWorld());
   RenderScene scene;
   scene.terrain = &terrain;
   scene.sun_direction = Eigen::Vector3d(-1, 0, 1).normalized();
@@ -193,7 +193,7 @@ Eigen::Isometry3d LevelAlongX(const Terrain& terrain) {
 // quarter of its width is three quarters white (one ray per pixel would make it all white, and
 // every edge would snap to pixel boundaries).
 TEST(CameraRendererTest, AMarkerEdgeThroughAPixelGivesItTheCoveredShare) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(RenderWorld());
   const PinholeRadTan k = Pinhole(320, 240, 200.0, 159.5, 119.5);
   const Eigen::Isometry3d T_world_cam = LevelAlongX(terrain);
   // Face on at 2 m: marker x runs along image u at 100 px/m. The quiet ring ends and the black
@@ -229,7 +229,7 @@ TEST(CameraRendererTest, AMarkerEdgeThroughAPixelGivesItTheCoveredShare) {
 // centre ray meets it): some of that pixel's rays point above the horizon and never meet its
 // plane. They must not be followed to infinity (an integer overflow under UBSan).
 TEST(CameraRendererTest, AMarkerSeenAtAGrazingAngleRendersWithoutOverflow) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(RenderWorld());
   // Row 60's centre 0.2 px below the horizon, its top rays above.
   const PinholeRadTan k = Pinhole(160, 120, 100.0, 79.5, 59.8);
   const Eigen::Isometry3d T_world_cam = LevelAlongX(terrain);

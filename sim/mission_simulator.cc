@@ -18,8 +18,6 @@
 namespace cairn::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 std::string MarkerRow(const SimMarker& m) {
   const Eigen::Vector3d p = m.T_body_marker.translation();
   const Eigen::Quaterniond q(m.T_body_marker.linear());
@@ -99,10 +97,10 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
       m.id = 200 + k;
       m.size = 2.0 * tag;
       m.bits = *Tag36h11MarkerBits(m.id);
-      const double az = kPi / 2 * k;
+      const double az = std::numbers::pi / 2 * k;
       m.T_body_marker.linear() = (Eigen::AngleAxisd(az, Eigen::Vector3d::UnitZ()) *
-                                  Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitY()) *
-                                  Eigen::AngleAxisd(-kPi / 2, Eigen::Vector3d::UnitZ()))
+                                  Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(-std::numbers::pi / 2, Eigen::Vector3d::UnitZ()))
                                      .toRotationMatrix();
       m.T_body_marker.translation() = Eigen::Vector3d(x, y, z + 0.7) + 0.81 * Eigen::Vector3d(std::cos(az), std::sin(az), 0);
       sim->landmarks_.push_back(m);
@@ -112,7 +110,7 @@ Expected<std::unique_ptr<MissionSimulator>> MissionSimulator::Create(const World
 }
 
 Eigen::Vector3d MissionSimulator::sun_direction() const {
-  const double az = world_.sun_azimuth * kPi / 180, el = world_.sun_elevation * kPi / 180;
+  const double az = world_.sun_azimuth * std::numbers::pi / 180, el = world_.sun_elevation * std::numbers::pi / 180;
   return Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
 }
 

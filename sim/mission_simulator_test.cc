@@ -19,7 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-WorldOptions SmallWorld(int64_t seed) {
+WorldOptions MissionWorld(int64_t seed) {
   WorldOptions w;
   w.size = 30.0;
   w.resolution = 0.2;
@@ -72,7 +72,7 @@ uint64_t TreeHash(const std::string& root) {
 }
 
 TEST(MissionSimulatorTest, WritesEurocFoldersThatTheReplayOpensUnchanged) {
-  auto sim = MissionSimulator::Create(SmallWorld(3), ShortMission());
+  auto sim = MissionSimulator::Create(MissionWorld(3), ShortMission());
   ASSERT_TRUE(sim.ok()) << sim.status().ToString();
   const std::string dir = testing::FreshTempDir("sim_euroc");
   ASSERT_TRUE((*sim)->Write(dir, nullptr).ok());
@@ -104,7 +104,7 @@ TEST(MissionSimulatorTest, SameSeedGivesIdenticalBytesOtherSeedDoesNot) {
   const std::string a = testing::FreshTempDir("sim_det_a"), b = testing::FreshTempDir("sim_det_b"),
                     c = testing::FreshTempDir("sim_det_c");
   for (const auto& [dir, seed] : {std::pair{a, 3}, std::pair{b, 3}, std::pair{c, 4}}) {
-    auto sim = MissionSimulator::Create(SmallWorld(seed), ShortMission());
+    auto sim = MissionSimulator::Create(MissionWorld(seed), ShortMission());
     ASSERT_TRUE(sim.ok());
     ASSERT_TRUE((*sim)->Write(dir, nullptr).ok());
   }
@@ -137,7 +137,7 @@ TEST(MissionSimulatorTest, RobotsSeeEachOther) {
   // with and once without other robots must differ somewhere over a few seconds.
   MissionOptions m = ShortMission();
   m.duration = 1.0;
-  auto sim = MissionSimulator::Create(SmallWorld(3), m);
+  auto sim = MissionSimulator::Create(MissionWorld(3), m);
   ASSERT_TRUE(sim.ok());
   const RenderScene scene = (*sim)->SceneAt(0.5);
   EXPECT_EQ(scene.markers.size(), 3u + 1u + 1u + 4u);  // rover tags and roof tag, hexacopter tag, lander tags
@@ -152,7 +152,7 @@ TEST(MissionSimulatorTest, DeployedRobotsStartInFrontOfALanderTagAndSeeIt) {
   m.duration = 40.0;
   m.image_scale = 1.0;
   m.deploy_from_lander = true;
-  WorldOptions world = SmallWorld(3);
+  WorldOptions world = MissionWorld(3);
   world.lander = {4.0, -3.0};
   auto sim = MissionSimulator::Create(world, m);
   ASSERT_TRUE(sim.ok()) << sim.status().ToString();
@@ -191,7 +191,7 @@ TEST(MissionSimulatorTest, DeployedRobotsStartInFrontOfALanderTagAndSeeIt) {
 TEST(MissionSimulatorTest, ARoofTagIsSeenFromAboveAndNotByItsRover) {
   MissionOptions m = ShortMission();
   m.image_scale = 1.0;
-  auto sim = MissionSimulator::Create(SmallWorld(3), m);
+  auto sim = MissionSimulator::Create(MissionWorld(3), m);
   ASSERT_TRUE(sim.ok());
   const SimRobot& rover = (*sim)->robots()[0];
   const SimRobot& hexacopter = (*sim)->robots()[1];
@@ -223,7 +223,7 @@ TEST(MissionSimulatorTest, ARoofTagIsSeenFromAboveAndNotByItsRover) {
   EXPECT_EQ(std::find(own_seen.begin(), own_seen.end(), 3), own_seen.end())
       << "the rover sees its own roof tag";
   // Without the key's tag (0), rovers carry none.
-  WorldOptions bare = SmallWorld(3);
+  WorldOptions bare = MissionWorld(3);
   bare.roof_tag_size = 0.0;
   auto without = MissionSimulator::Create(bare, m);
   ASSERT_TRUE(without.ok());
@@ -238,10 +238,10 @@ TEST(MissionSimulatorTest, MotionBlurSmoothsTheImage) {
   m.image_scale = 0.2;
   m.render.read_noise = 0.0;
   m.render.shot_noise = 0.0;
-  auto sharp = MissionSimulator::Create(SmallWorld(3), m);
+  auto sharp = MissionSimulator::Create(MissionWorld(3), m);
   m.motion_blur_samples = 7;
   m.exposure_time = 0.08;  // long exposure at 1 m/s: about 8 cm of travel
-  auto blurred = MissionSimulator::Create(SmallWorld(3), m);
+  auto blurred = MissionSimulator::Create(MissionWorld(3), m);
   ASSERT_TRUE(sharp.ok() && blurred.ok());
   std::vector<uint8_t> a, b, unused;
   (*sharp)->RenderStereo(0, 3.0, 30, &a, &unused);
@@ -262,9 +262,9 @@ TEST(MissionSimulatorTest, RenderThreadsDoNotChangeTheImages) {
   MissionOptions m = ShortMission();
   m.image_scale = 0.25;
   m.motion_blur_samples = 3;
-  auto one = MissionSimulator::Create(SmallWorld(3), m);
+  auto one = MissionSimulator::Create(MissionWorld(3), m);
   m.render_threads = 2;
-  auto two = MissionSimulator::Create(SmallWorld(3), m);
+  auto two = MissionSimulator::Create(MissionWorld(3), m);
   ASSERT_TRUE(one.ok() && two.ok());
   for (size_t r = 0; r < 2; ++r) {
     std::vector<uint8_t> left1, right1, left2, right2;
@@ -277,17 +277,17 @@ TEST(MissionSimulatorTest, RenderThreadsDoNotChangeTheImages) {
     EXPECT_NE(left1, right1);
   }
   m.render_threads = 3;
-  EXPECT_FALSE(MissionSimulator::Create(SmallWorld(3), m).ok());
+  EXPECT_FALSE(MissionSimulator::Create(MissionWorld(3), m).ok());
 }
 
 TEST(MissionSimulatorTest, RejectsUnknownAndDuplicateRobots) {
   MissionOptions m = ShortMission();
   m.robots = {"rover", "submarine"};
-  auto sim = MissionSimulator::Create(SmallWorld(1), m);
+  auto sim = MissionSimulator::Create(MissionWorld(1), m);
   ASSERT_FALSE(sim.ok());
   EXPECT_NE(sim.status().message().find("submarine"), std::string::npos);
   m.robots = {"rover", "rover"};
-  EXPECT_FALSE(MissionSimulator::Create(SmallWorld(1), m).ok());
+  EXPECT_FALSE(MissionSimulator::Create(MissionWorld(1), m).ok());
 }
 
 }  // namespace

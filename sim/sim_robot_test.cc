@@ -6,13 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "sim/terrain.h"
 #include "sim/world_options.h"
 
 namespace cairn::sim {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180;
 
 // The steepest tilt of a robot's body (angle of its z axis from the vertical) over its trajectory.
 double MaxTilt(const SimRobot& robot, double duration) {
@@ -39,7 +38,7 @@ TEST(SimRobotTest, RoversKeepOffGroundThatTiltsThemMoreThan25Degrees) {
     for (int index : {0, 2}) {
       const SimRobot rover = MakeRover(terrain, "rover", index, static_cast<uint64_t>(seed), 120.0, 0.1,
                                        world.tag_size, &deployment);
-      EXPECT_LT(MaxTilt(rover, 120.0), 25.5 * kDeg) << "seed " << seed << ", rover " << index;
+      EXPECT_LT(MaxTilt(rover, 120.0), 25.5 * kDegree) << "seed " << seed << ", rover " << index;
     }
   }
 }
@@ -78,7 +77,7 @@ TEST(SimRobotTest, ADrivableLoopIsDrivenAsDrawn) {
   };
   EXPECT_LT(LargestGap(rover2(level), rover2(gentle), 60.0), 1e-9);
   EXPECT_GT(LargestGap(rover2(level), rover2(rough), 60.0), 1.0);
-  EXPECT_LT(MaxTilt(rover2(rough), 60.0), 25.5 * kDeg);
+  EXPECT_LT(MaxTilt(rover2(rough), 60.0), 25.5 * kDegree);
 }
 
 }  // namespace

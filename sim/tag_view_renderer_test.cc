@@ -8,7 +8,7 @@
 namespace cairn::sim {
 namespace {
 
-WorldOptions SmallWorld() {
+WorldOptions TagWorld() {
   WorldOptions w;
   w.size = 20.0;
   w.resolution = 0.2;
@@ -26,7 +26,7 @@ PinholeRadTan RoverLike() {
 }
 
 TEST(TagViewRendererTest, TheDetectorFindsTheTagWhereItWasDrawn) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(TagWorld());
   const PinholeRadTan k = RoverLike();
   const TagViewRenderer renderer(terrain, k);
   Eigen::Isometry3d T_cam_tag = Eigen::Isometry3d::Identity();
@@ -56,7 +56,7 @@ TEST(TagViewRendererTest, TheDetectorFindsTheTagWhereItWasDrawn) {
 }
 
 TEST(TagViewRendererTest, RefusesTagsOutsideTheImageOrBehindTheCamera) {
-  const Terrain terrain = Terrain::Generate(SmallWorld());
+  const Terrain terrain = Terrain::Generate(TagWorld());
   const TagViewRenderer renderer(terrain, RoverLike());
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.translation() = Eigen::Vector3d(0.0, 0.0, -2.0);

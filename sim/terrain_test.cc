@@ -10,7 +10,7 @@
 namespace cairn::sim {
 namespace {
 
-WorldOptions SmallWorld() {
+WorldOptions TerrainWorld() {
   WorldOptions w;
   w.size = 20.0;
   w.seed = 7;
@@ -27,8 +27,8 @@ Eigen::Vector3d RandomGroundPoint(SimRandom& rng) {
 }
 
 TEST(TerrainTest, SameSeedSameTerrainOtherSeedOtherTerrain) {
-  const Terrain a = Terrain::Generate(SmallWorld()), b = Terrain::Generate(SmallWorld());
-  WorldOptions o = SmallWorld();
+  const Terrain a = Terrain::Generate(TerrainWorld()), b = Terrain::Generate(TerrainWorld());
+  WorldOptions o = TerrainWorld();
   o.seed = 8;
   const Terrain c = Terrain::Generate(o);
   int differ = 0;
@@ -43,7 +43,7 @@ TEST(TerrainTest, SameSeedSameTerrainOtherSeedOtherTerrain) {
 }
 
 TEST(TerrainTest, RocksAddSteepStepsToTheGround) {
-  WorldOptions smooth = SmallWorld();
+  WorldOptions smooth = TerrainWorld();
   smooth.rock_density = 0.0;
   smooth.crater_density = 0.0;
   smooth.big_crater = false;
@@ -62,7 +62,7 @@ TEST(TerrainTest, RocksAddSteepStepsToTheGround) {
 }
 
 TEST(TerrainTest, RockSizeScalesTheBoulders) {
-  WorldOptions flat = SmallWorld();
+  WorldOptions flat = TerrainWorld();
   flat.relief = 0.0;
   flat.crater_density = 0.0;
   flat.big_crater = false;
@@ -85,7 +85,7 @@ TEST(TerrainTest, RockSizeScalesTheBoulders) {
 // The max-mipmap traversal must return the first intersection: the hit lies on the surface and
 // no sample before it along the ray is below the surface.
 TEST(TerrainTest, RaycastFindsTheFirstSurfaceHit) {
-  const Terrain t = Terrain::Generate(SmallWorld());
+  const Terrain t = Terrain::Generate(TerrainWorld());
   SimRandom rng(3);
   int hits = 0;
   for (int i = 0; i < 400; ++i) {
@@ -113,7 +113,7 @@ TEST(TerrainTest, RaycastFindsTheFirstSurfaceHit) {
 
 // A start distance the ray is clear up to changes nothing about the hit.
 TEST(TerrainTest, RaycastFromAClearDistanceFindsTheSameHit) {
-  const Terrain t = Terrain::Generate(SmallWorld());
+  const Terrain t = Terrain::Generate(TerrainWorld());
   SimRandom rng(5);
   int hits = 0;
   for (int i = 0; i < 400; ++i) {
@@ -136,7 +136,7 @@ TEST(TerrainTest, RaycastFromAClearDistanceFindsTheSameHit) {
 // Every ray of a bundle (unit directions within `spread` of the central one) is clear of the
 // terrain up to the bundle's clear distance, and the distance is not trivially short.
 TEST(TerrainTest, ClearDistanceBoundsEveryRayOfTheBundle) {
-  const Terrain t = Terrain::Generate(SmallWorld());
+  const Terrain t = Terrain::Generate(TerrainWorld());
   SimRandom rng(11);
   double gained = 0.0;
   int bundles = 0;
@@ -171,7 +171,7 @@ TEST(TerrainTest, ClearDistanceBoundsEveryRayOfTheBundle) {
 
 // max_slope bounds the height difference of any two points by their distance.
 TEST(TerrainTest, MaxSlopeBoundsTheSurface) {
-  const Terrain t = Terrain::Generate(SmallWorld());
+  const Terrain t = Terrain::Generate(TerrainWorld());
   SimRandom rng(13);
   double steepest = 0.0;
   for (int i = 0; i < 20000; ++i) {
@@ -186,7 +186,7 @@ TEST(TerrainTest, MaxSlopeBoundsTheSurface) {
 }
 
 TEST(TerrainTest, RaysUpIntoTheSkyMiss) {
-  const Terrain t = Terrain::Generate(SmallWorld());
+  const Terrain t = Terrain::Generate(TerrainWorld());
   EXPECT_LT(t.Raycast({0, 0, t.Height(0, 0) + 1.0}, Eigen::Vector3d(1, 0, 1).normalized(), 100).t, 0.0);
   EXPECT_LT(t.Raycast({50, 0, 5.0}, Eigen::Vector3d(1, 0, -0.1).normalized(), 100).t, 0.0);
 }

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/angles.h"
 #include "common/atomic_file.h"
 #include "common/json_writer.h"
 #include "detection/tag_detector.h"
@@ -26,7 +27,6 @@
 namespace cairn::tools {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr int kTagId = 0;
 
 constexpr const char* kBuildUsage =
@@ -234,7 +234,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
   const PinholeRadTan& k = camera->intrinsics;
   const sim::TagViewRenderer renderer(terrain, k);
   TagDetector detector(DaemonDetector(decimate));
-  TagErrorTable table(camera_name, k.width, k.height, k.fx, k.fy, tag_size, d0, d1, nd, a0 * kDeg, a1 * kDeg, na);
+  TagErrorTable table(camera_name, k.width, k.height, k.fx, k.fy, tag_size, d0, d1, nd, a0 * kDegree, a1 * kDegree, na);
   std::mt19937_64 rng(static_cast<uint64_t>(seed));
   double corner_sq = 0.0;
   int corner_n = 0, rendered = 0, detected = 0;
@@ -343,11 +343,11 @@ int RunDetectCheckLut(const CommandArgs& args) {
   int rendered = 0, detected = 0, in_range = 0, in_range_detected = 0, flips = 0, refused_residual = 0;
   for (int s = 0; s < static_cast<int>(samples); ++s) {
     const double d = table->distance_at(0) + unit(rng) * (1.5 * last - table->distance_at(0));
-    const double angle = unit(rng) * 80.0 * kDeg;
+    const double angle = unit(rng) * 80.0 * kDegree;
     const Sighting si = RenderAndDetect(renderer, k, tag_size, d, angle, true, rng, detector);
     if (!si.rendered) continue;
     ++rendered;
-    const bool inside = d <= max_distance && angle <= max_angle * kDeg;
+    const bool inside = d <= max_distance && angle <= max_angle * kDegree;
     in_range += inside;
     if (!si.detected) continue;
     ++detected;

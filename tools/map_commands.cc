@@ -23,6 +23,7 @@
 #include "sim/obstacle_ground_truth.h"
 #include "sim/testing/sim_depth_scenes.h"
 #include "tools/commands.h"
+#include "tools/sample_median.h"
 
 namespace cairn::tools {
 namespace {
@@ -30,12 +31,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double Ms(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
 
 bool ParseNumber(const std::string& s, double* out) {
   char* end = nullptr;

@@ -19,6 +19,7 @@
 #include "mapping/matching/submap_matcher.h"
 #include "mapping/submap_codec.h"
 #include "tools/commands.h"
+#include "tools/sample_median.h"
 
 namespace cairn::tools {
 namespace {
@@ -129,12 +130,6 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
     near += hit;
   }
   return total == 0 ? 0.0 : static_cast<double>(near) / static_cast<double>(total);
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "estimation/vo/keyframe_visual_odometry.h"
 #include "io/image_codec.h"
 #include "tools/commands.h"
+#include "tools/sample_median.h"
 
 namespace cairn::tools {
 namespace {
@@ -40,12 +41,6 @@ Expected<Trajectory> ReadAny(const std::string& path) {
   auto format = TrajectoryIo::FormatFromPath(path);
   if (!format.ok()) return format.status();
   return TrajectoryIo::Read(path, *format);
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 }  // namespace

@@ -4,13 +4,13 @@
 #include <chrono>
 #include <cstdio>
 
+#include "common/bounded_errors.h"
 #include "common/monotonic_clock.h"
 #include "daemon/comms/curve_keys.h"
 
 namespace cairn {
 namespace {
 
-constexpr size_t kMaxErrors = 10;
 constexpr size_t kMaxBatchPoints = 512;
 
 }  // namespace
@@ -90,7 +90,7 @@ Status CommsStage::Open() {
 }
 
 void CommsStage::Error(const std::string& what) {
-  if (report_.errors.size() < kMaxErrors) report_.errors.push_back(what);
+  AppendBoundedError(report_.errors, what);
 }
 
 void CommsStage::OnItem(const StoreItem& item) {

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <set>
 
+#include "common/bounded_errors.h"
 #include "common/heap_bytes.h"
 #include "common/monotonic_clock.h"
 #include "detection/gravity_agreement.h"
@@ -34,7 +35,6 @@ Eigen::Isometry3d ToIsometry(const Pose3& p) {
   return T;
 }
 
-constexpr size_t kMaxErrors = 10;
 
 }  // namespace
 
@@ -61,7 +61,7 @@ Matrix6d GraphStage::Floored(const Matrix6d& covariance) const {
 }
 
 void GraphStage::Error(const std::string& what) {
-  if (report_.errors.size() < kMaxErrors) report_.errors.push_back(what);
+  AppendBoundedError(report_.errors, what);
 }
 
 bool GraphStage::Add(const SlamFactor& f) {

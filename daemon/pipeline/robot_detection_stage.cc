@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/bounded_errors.h"
 #include "common/monotonic_clock.h"
 
 namespace cairn {
 namespace {
-
-constexpr size_t kMaxErrors = 10;
 
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d S;
@@ -145,7 +144,7 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
   report_.unknown_ids += unknown() - unknown_before;
   if (!found.ok()) {
     ++report_.bad_images;
-    if (report_.errors.size() < kMaxErrors) report_.errors.push_back(found.status().ToString());
+    AppendBoundedError(report_.errors, found.status().ToString());
     time_.Record(clock.Now() - start);
     return;
   }
@@ -173,7 +172,7 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
     const auto pose = TagPoseEstimator(po).Estimate(d.corners, camera_);
     if (!pose.ok()) {
       ++report_.pose_failures;
-      if (report_.errors.size() < kMaxErrors) report_.errors.push_back("tag " + std::to_string(d.id) + ": " + pose.status().ToString());
+      AppendBoundedError(report_.errors, "tag " + std::to_string(d.id) + ": " + pose.status().ToString());
       continue;
     }
     const Eigen::Isometry3d T_tag_carrier = mount->T_carrier_tag.inverse();

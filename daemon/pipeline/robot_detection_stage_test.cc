@@ -57,7 +57,7 @@ TagCarrierTable Table() {
   return t;
 }
 
-RobotDetectionOptions Options() {
+RobotDetectionOptions DetectionOptions() {
   RobotDetectionOptions o;
   o.enabled = true;
   o.detector.decimate = 1.0;
@@ -96,7 +96,7 @@ RectifiedPair PairOf(const cv::Mat& left, int64_t time_ns) {
 
 TEST(RobotDetectionStageTest, ATeammatesTagGivesItsBodyInOursAtTheExposureTime) {
   const TagCarrierTable table = Table();
-  RobotDetectionStage stage(Options(), table, ModelFor(Options()), Camera(), BodyCam(), "hexacopter", 'b');
+  RobotDetectionStage stage(DetectionOptions(), table, ModelFor(DetectionOptions()), Camera(), BodyCam(), "hexacopter", 'b');
   const Eigen::Isometry3d T_cam_tag = TagInView(3.0, 25 * kDeg);
   const cv::Mat image = testing::RenderTag(10, 0.16, T_cam_tag, Pinhole());
   std::vector<TagSighting> out;
@@ -121,7 +121,7 @@ TEST(RobotDetectionStageTest, ATeammatesTagGivesItsBodyInOursAtTheExposureTime) 
 
 TEST(RobotDetectionStageTest, OwnTagsAreDroppedFarTagsRefusedLandmarksKept) {
   const TagCarrierTable table = Table();
-  RobotDetectionOptions o = Options();
+  RobotDetectionOptions o = DetectionOptions();
   o.max_distance = 3.5;
   RobotDetectionStage stage(o, table, ModelFor(o), Camera(), BodyCam(), "rover", 'a');
   cv::Mat image(508, 1024, CV_8UC1, cv::Scalar(128));
@@ -150,7 +150,7 @@ TEST(RobotDetectionStageTest, OwnTagsAreDroppedFarTagsRefusedLandmarksKept) {
 }
 
 TEST(RobotDetectionStageTest, AnErrorTableOfAnotherCameraOrAMissingOneIsRefusedAtStartUp) {
-  RobotDetectionOptions o = Options();
+  RobotDetectionOptions o = DetectionOptions();
   const std::string dir = testing::SourceDir() + "/configs/detection/";
   // The hexacopter's table on the rover's camera: another field of view.
   auto m = RobotDetectionStage::MakeErrorModel(o, dir + "hexacopter.lut", Camera());
@@ -182,7 +182,7 @@ TEST(RobotDetectionStageTest, AnErrorTableOfAnotherCameraOrAMissingOneIsRefusedA
 // it saw lately, at full resolution: it follows a teammate's tag to where the whole-frame scan
 // no longer finds it, and stops looking once the tag has been gone for the track timeout.
 TEST(RobotDetectionStageTest, RegionScansFollowATagBetweenWholeFrameScans) {
-  RobotDetectionOptions o = Options();
+  RobotDetectionOptions o = DetectionOptions();
   o.detector.decimate = 2.0;
   o.every_nth_frame = 4;
   o.roi_every_nth_frame = 1;  // every 4th frame whole, the 3 between in regions
@@ -238,7 +238,7 @@ TEST(RobotDetectionStageTest, RegionsGrowByTheMarginsAndStayInsideTheImage) {
 }
 
 TEST(RobotDetectionStageTest, BadImagesAreCountedNotFatal) {
-  RobotDetectionStage stage(Options(), Table(), ModelFor(Options()), Camera(), BodyCam(), "rover", 'a');
+  RobotDetectionStage stage(DetectionOptions(), Table(), ModelFor(DetectionOptions()), Camera(), BodyCam(), "rover", 'a');
   std::vector<TagSighting> out;
   stage.Process(RectifiedPair{}, &out);
   EXPECT_TRUE(out.empty());

@@ -4,10 +4,10 @@
 #include <cstdio>
 #include <utility>
 
+#include "common/bounded_errors.h"
+
 namespace cairn {
 namespace {
-
-constexpr size_t kMaxErrors = 10;
 
 std::string Key(const SubmapKey& k) { return k.robot + "/" + std::to_string(k.id); }
 
@@ -56,7 +56,7 @@ void SubmapMatchingStage::Start() {
 }
 
 void SubmapMatchingStage::Error(const std::string& what) {
-  if (report_.errors.size() < kMaxErrors) report_.errors.push_back(what);
+  AppendBoundedError(report_.errors, what);
 }
 
 SubmapMatchingStage::Done SubmapMatchingStage::Run(const Job& job) const {

@@ -21,7 +21,7 @@ Trajectory Arc(double y, double turn, int n) {
 }
 
 // The trajectory as a graph whose global frame is `T_view_world` away states it.
-Trajectory Moved(Trajectory t, const Eigen::Isometry3d& T_view_world) {
+Trajectory InViewFrame(Trajectory t, const Eigen::Isometry3d& T_view_world) {
   std::for_each(t.poses.begin(), t.poses.end(), [&](StampedPose& p) { p.T_frame_body = T_view_world * p.T_frame_body; });
   return t;
 }
@@ -36,8 +36,8 @@ Eigen::Isometry3d Frame(double x, double y, double yaw) {
 TEST(TeamAgreementTest, ViewsInDifferentFramesOfTheSameTeamAgree) {
   const Trajectory a = Arc(0.0, 0.02, 60), b = Arc(5.0, -0.03, 40);
   std::vector<TeamView> views = {{"a", {{"a", a}, {"b", b}}},
-                                 {"b", {{"a", Moved(a, Frame(3, -2, 0.8))}, {"b", Moved(b, Frame(3, -2, 0.8))}}},
-                                 {"c", {{"b", Moved(b, Frame(-1, 4, -2.0))}, {"a", Moved(a, Frame(-1, 4, -2.0))}}}};
+                                 {"b", {{"a", InViewFrame(a, Frame(3, -2, 0.8))}, {"b", InViewFrame(b, Frame(3, -2, 0.8))}}},
+                                 {"c", {{"b", InViewFrame(b, Frame(-1, 4, -2.0))}, {"a", InViewFrame(a, Frame(-1, 4, -2.0))}}}};
   auto r = CompareTeamViews(views);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_EQ(r->views, 3);
@@ -52,7 +52,7 @@ TEST(TeamAgreementTest, AViewThatPlacesATeammateElsewhereIsFound) {
   Eigen::Isometry3d off = Frame(0.005, 0.0, 0.05 * M_PI / 180.0);
   off.translation().z() = 0.0;
   std::vector<TeamView> views = {{"a", {{"a", a}, {"b", b}}},
-                                 {"c", {{"a", Moved(a, Frame(1, 1, 0.3))}, {"b", Moved(Moved(b, off), Frame(1, 1, 0.3))}}}};
+                                 {"c", {{"a", InViewFrame(a, Frame(1, 1, 0.3))}, {"b", InViewFrame(InViewFrame(b, off), Frame(1, 1, 0.3))}}}};
   auto r = CompareTeamViews(views);
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_GT(r->max_position, 1e-3);

@@ -8,8 +8,6 @@
 namespace cairn {
 namespace {
 
-constexpr int kCloneDims = kStateDim - kCoreDim;
-
 // The parts of P above the block diagonal: the top-right core-clone block and the clone-clone
 // blocks above the diagonal.
 void ZeroUpper(StateCovariance& P) {

@@ -19,6 +19,7 @@ namespace cairn {
 inline constexpr int kMaxClones = 12;
 inline constexpr int kCoreDim = 15;
 inline constexpr int kStateDim = kCoreDim + 6 * kMaxClones;
+inline constexpr int kCloneDims = kStateDim - kCoreDim;
 inline constexpr int kP = 0, kV = 3, kTheta = 6, kBa = 9, kBg = 12;
 constexpr int CloneIndex(int slot) { return kCoreDim + 6 * slot; }
 

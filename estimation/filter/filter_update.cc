@@ -9,7 +9,6 @@
 namespace cairn {
 namespace {
 
-constexpr int kCloneDims = kStateDim - kCoreDim;
 using CoreMatrix = Eigen::Matrix<double, kCoreDim, kCoreDim>;
 
 bool Active(const FilterState& s, int slot) { return s.clones[static_cast<size_t>(slot)].id != kNoClone; }

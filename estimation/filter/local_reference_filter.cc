@@ -348,7 +348,6 @@ void LocalReferenceFilter::AddClone(CloneId id) {
   Eigen::Matrix<double, kCoreDim, 6> pose_cols_phi_t;  // columns p, theta of phi^T
   pose_cols_phi_t.leftCols<3>() = state_.phi.middleRows<3>(kP).transpose();
   pose_cols_phi_t.rightCols<3>() = state_.phi.middleRows<3>(kTheta).transpose();
-  constexpr int kCloneDims = kStateDim - kCoreDim;
   Eigen::Matrix<double, kCloneDims, 6> with_new;
   kernels::MulRows<kCoreDim, 6, kernels::kSet>(with_new.data(), kCloneDims, &state_.P(kCoreDim, 0), kStateDim,
                                                kCloneDims, pose_cols_phi_t.data(), kCoreDim);

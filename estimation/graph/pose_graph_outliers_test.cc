@@ -20,7 +20,7 @@ namespace {
 
 using Options = PoseGraphSolverOptions;
 
-Pose3 RandomPose(std::mt19937& rng, double extent) {
+Pose3 RandomPoseWithin(std::mt19937& rng, double extent) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   std::normal_distribution<double> n(0.0, 1.0);
   const Eigen::Vector3d t = extent * DrawVector3(u, rng);
@@ -77,7 +77,7 @@ struct Scene {
     std::uniform_int_distribution<size_t> pi(lo_i, hi_i), pj(lo_j, hi_j);
     size_t i = pi(rng), j = pj(rng);
     while (j == i || j == i + 1 || i == j + 1) j = pj(rng);
-    AddEdge(keys[i], keys[j], RandomPose(rng, 10.0), 0.01);
+    AddEdge(keys[i], keys[j], RandomPoseWithin(rng, 10.0), 0.01);
     return graph.edges().size() - 1;
   }
 };

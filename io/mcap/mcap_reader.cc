@@ -12,11 +12,11 @@
 #include "io/byte_reader.h"
 #include "io/compression.h"
 #include "io/crc32.h"
+#include "io/mcap/mcap_magic.h"
 
 namespace cairn {
 namespace {
 
-constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 constexpr size_t kFooterRecordSize = 1 + 8 + 8 + 8 + 4;
 
 struct FileCloser {
@@ -125,7 +125,7 @@ Expected<McapScanResult> McapReader::Scan(const MessageCallback& on_message,
   File f(std::fopen(path_.c_str(), "rb"));
   if (!f) return NotFoundError(path_ + ": cannot open: " + std::strerror(errno));
   uint8_t magic[8];
-  if (std::fread(magic, 1, 8, f.get()) != 8 || std::memcmp(magic, kMagic, 8) != 0) {
+  if (std::fread(magic, 1, 8, f.get()) != 8 || std::memcmp(magic, kMcapMagic, 8) != 0) {
     return DataLossError(path_ + ": not an MCAP file (bad magic)");
   }
   // A record longer than the rest of the file is a truncated file, not a size to allocate.
@@ -181,7 +181,7 @@ Expected<McapSummary> McapReader::ReadSummary() const {
   std::vector<uint8_t> tail(kFooterRecordSize + 8);
   std::fseek(f.get(), size - static_cast<long>(tail.size()), SEEK_SET);
   if (std::fread(tail.data(), 1, tail.size(), f.get()) != tail.size()) return IoError(path_ + ": read failed");
-  if (std::memcmp(tail.data() + kFooterRecordSize, kMagic, 8) != 0 || tail[0] != 0x02) {
+  if (std::memcmp(tail.data() + kFooterRecordSize, kMcapMagic, 8) != 0 || tail[0] != 0x02) {
     return DataLossError(path_ + ": no footer (the file was not closed; scan it instead)");
   }
   ByteReader fr(std::span<const uint8_t>(tail).subspan(9));

@@ -4,10 +4,10 @@
 #include <cerrno>
 #include <cstring>
 
+#include "io/mcap/mcap_magic.h"
+
 namespace cairn {
 namespace {
-
-constexpr uint8_t kMagic[8] = {0x89, 'M', 'C', 'A', 'P', '0', '\r', '\n'};
 
 enum Op : uint8_t {
   kHeader = 0x01, kFooter = 0x02, kSchema = 0x03, kChannel = 0x04, kMessage = 0x05, kChunk = 0x06,
@@ -38,7 +38,7 @@ Status McapWriter::Open(const std::string& path, const McapWriterOptions& option
   options_ = options;
   offset_ = 0;
   chunk_.buffer().reserve(options.chunk_size + options.chunk_size / 8);
-  CAIRN_RETURN_IF_ERROR(Append(kMagic));
+  CAIRN_RETURN_IF_ERROR(Append(kMcapMagic));
   ByteWriter w;
   const size_t len = w.BeginRecord(kHeader);
   w.String(options.profile);
@@ -241,7 +241,7 @@ Status McapWriter::Close() {
     s.U64(summary_offset_start);
     const uint32_t crc = Crc32::Of(s.buffer());
     s.U32(crc);
-    s.Bytes(kMagic);
+    s.Bytes(kMcapMagic);
     status = Append(s);
   }
   if (std::fclose(file_) != 0 && status.ok()) status = IoError(path_ + ": close failed: " + std::strerror(errno));

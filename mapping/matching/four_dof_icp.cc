@@ -18,7 +18,7 @@ namespace cairn {
 namespace {
 
 // The finite target points as nanoflann reads them.
-struct CloudAdaptor {
+struct IcpCloudAdaptor {
   const std::vector<Eigen::Vector3d>* points;
 
   size_t kdtree_get_point_count() const { return points->size(); }
@@ -29,8 +29,8 @@ struct CloudAdaptor {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>,
-                                                   CloudAdaptor, 3, uint32_t>;
+using IcpKdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, IcpCloudAdaptor>,
+                                                   IcpCloudAdaptor, 3, uint32_t>;
 
 std::string Num(double v) {
   char buf[32];
@@ -51,7 +51,7 @@ std::vector<Eigen::Vector3d> FinitePoints(std::span<const Eigen::Vector3d> in, s
 
 // Unit normals of the target points from the PCA of their neighbourhoods; `good` marks those
 // whose neighbourhood is a well-sampled plane. Returns the count of good ones.
-size_t ComputeNormals(const KdTree& tree, const std::vector<Eigen::Vector3d>& points,
+size_t ComputeNormals(const IcpKdTree& tree, const std::vector<Eigen::Vector3d>& points,
                       const FourDofIcpOptions& o, std::vector<Eigen::Vector3d>* normals,
                       std::vector<uint8_t>* good) {
   const size_t k = std::min(static_cast<size_t>(o.normal_neighbours), points.size());
@@ -106,7 +106,7 @@ struct Pass {
 class Aligner {
  public:
   Aligner(const FourDofIcpOptions& o, const std::vector<Eigen::Vector3d>& source,
-          const std::vector<Eigen::Vector3d>& target, const KdTree& tree,
+          const std::vector<Eigen::Vector3d>& target, const IcpKdTree& tree,
           const std::vector<Eigen::Vector3d>& normals, const std::vector<uint8_t>& good)
       : unique_(o.unique_targets),
         source_(source),
@@ -180,7 +180,7 @@ class Aligner {
   bool unique_;
   const std::vector<Eigen::Vector3d>& source_;
   const std::vector<Eigen::Vector3d>& target_;
-  const KdTree& tree_;
+  const IcpKdTree& tree_;
   const std::vector<Eigen::Vector3d>& normals_;
   const std::vector<uint8_t>& good_;
   std::vector<uint32_t> nn_;      // per source point: its paired target point or kNone
@@ -268,8 +268,8 @@ FourDofIcpResult FourDofIcp::Align(std::span<const Eigen::Vector3d> target_a,
   if (too_few("source", source, res.skipped_source) || too_few("target", target, res.skipped_target))
     return res;
 
-  const CloudAdaptor adaptor{&target};
-  const KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  const IcpCloudAdaptor adaptor{&target};
+  const IcpKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   std::vector<Eigen::Vector3d> normals;
   std::vector<uint8_t> good;
   res.target_normals = ComputeNormals(tree, target, options_, &normals, &good);

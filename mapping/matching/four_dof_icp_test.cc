@@ -12,12 +12,11 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "estimation/math/ordered_draws.h"
 
 namespace cairn {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Samples the parallelogram o + a u + b v at cell centres shifted by `offset` (in cells) so that
 // two clouds of one scene can hold different points.
@@ -75,7 +74,7 @@ const FourDofTransform kTruth(1.5, -0.8, 0.2, 0.9);  // T_a_b
 
 // The truth moved by 0.3 m and 5 deg.
 FourDofTransform Perturbed(const FourDofTransform& truth) {
-  return FourDofTransform(truth.translation() + Eigen::Vector3d(0.2, -0.2, 0.1), truth.yaw() + 5.0 * kDeg);
+  return FourDofTransform(truth.translation() + Eigen::Vector3d(0.2, -0.2, 0.1), truth.yaw() + 5.0 * kDegree);
 }
 
 Eigen::Vector4d Error(const FourDofTransform& estimate, const FourDofTransform& truth) {
@@ -93,7 +92,7 @@ TEST(FourDofIcpTest, ConvergesFromAPerturbedStartOnNoiseFreeData) {
   EXPECT_TRUE(r.converged);
   const Eigen::Vector4d e = Error(r.T_a_b, kTruth);
   EXPECT_LT(e.head<3>().norm(), 1e-3) << e.transpose();
-  EXPECT_LT(std::abs(e(3)), 0.01 * kDeg) << e.transpose();
+  EXPECT_LT(std::abs(e(3)), 0.01 * kDegree) << e.transpose();
   EXPECT_LT(r.rms, 1e-4);
   EXPECT_GT(r.inliers, 1000u);
   EXPECT_GT(r.overlap, 0.5);
@@ -112,7 +111,7 @@ TEST(FourDofIcpTest, ConvergesWithCentimetreNoiseOnDifferentSamples) {
   ASSERT_TRUE(r.ok()) << r.status.ToString();
   const Eigen::Vector4d e = Error(r.T_a_b, kTruth);
   EXPECT_LT(e.head<3>().norm(), 0.005) << e.transpose();
-  EXPECT_LT(std::abs(e(3)), 0.1 * kDeg) << e.transpose();
+  EXPECT_LT(std::abs(e(3)), 0.1 * kDegree) << e.transpose();
   // Point-to-plane residuals of two clouds with 1 cm noise each: about sqrt(2) cm.
   EXPECT_GT(r.rms, 0.008);
   EXPECT_LT(r.rms, 0.02);
@@ -123,8 +122,8 @@ TEST(FourDofIcpTest, ConvergesWithCentimetreNoiseOnDifferentSamples) {
   std::printf("1 cm noise: %lld iterations, %zu inliers, rms %.4f m, observability %.4f\n",
               static_cast<long long>(r.iterations), r.inliers, r.rms, r.observability);
   std::printf("  error (mm, mm, mm, mdeg): %.2f %.2f %.2f %.2f, sigma: %.2f %.2f %.2f %.2f\n", e(0) * 1e3,
-              e(1) * 1e3, e(2) * 1e3, e(3) / kDeg * 1e3, sigma(0) * 1e3, sigma(1) * 1e3, sigma(2) * 1e3,
-              sigma(3) / kDeg * 1e3);
+              e(1) * 1e3, e(2) * 1e3, e(3) / kDegree * 1e3, sigma(0) * 1e3, sigma(1) * 1e3, sigma(2) * 1e3,
+              sigma(3) / kDegree * 1e3);
 }
 
 // Over repeated noisy trials the normalized estimation error squared e^T Sigma^-1 e of a
@@ -144,7 +143,7 @@ double MeanNees(const FourDofIcpOptions& options, int trials, uint64_t seed) {
     const std::vector<Eigen::Vector3d> target = Cloud(scene_a, -10.0, 2.0, FourDofTransform(), 0.01, rng());
     const std::vector<Eigen::Vector3d> source = Cloud(scene_b, -2.0, 10.0, kTruth.inverse(), 0.01, rng());
     const Eigen::Vector3d dt = 0.2 * DrawVector3(unit, rng);
-    const double dyaw = 3.0 * kDeg * unit(rng);
+    const double dyaw = 3.0 * kDegree * unit(rng);
     const FourDofTransform start(kTruth.translation() + dt, kTruth.yaw() + dyaw);
     const FourDofIcpResult r = FourDofIcp(options).Align(target, source, start);
     EXPECT_TRUE(r.ok()) << r.status.ToString() << " trial " << t;
@@ -185,14 +184,14 @@ TEST(FourDofIcpTest, RollingGroundIsObservable) {
   for (Eigen::Vector3d& p : ground) p.z() = 0.1 * std::sin(p.x() / 1.5) * std::cos(p.y() / 1.7) + 0.03 * p.x();
   const std::vector<Eigen::Vector3d> target = Cloud(ground, -10.0, 10.0, FourDofTransform(), 0.01, 9);
   const std::vector<Eigen::Vector3d> source = Cloud(ground, -10.0, 10.0, kTruth.inverse(), 0.01, 10);
-  const FourDofTransform start(kTruth.translation() + Eigen::Vector3d(0.05, -0.05, 0.0), kTruth.yaw() + 1.0 * kDeg);
+  const FourDofTransform start(kTruth.translation() + Eigen::Vector3d(0.05, -0.05, 0.0), kTruth.yaw() + 1.0 * kDegree);
   const FourDofIcpResult r = FourDofIcp().Align(target, source, start);
   std::printf("rolling ground: observability %.4f, %zu inliers\n", r.observability, r.inliers);
   ASSERT_TRUE(r.ok()) << r.status.ToString();
   EXPECT_GT(r.observability, FourDofIcpOptions{}.min_observability);
   EXPECT_LT(r.observability, 0.005);  // what the first threshold called degenerate
   EXPECT_LT((r.T_a_b.translation() - kTruth.translation()).norm(), 0.03);
-  EXPECT_LT(std::abs(r.T_a_b.yaw() - kTruth.yaw()), 0.2 * kDeg);
+  EXPECT_LT(std::abs(r.T_a_b.yaw() - kTruth.yaw()), 0.2 * kDegree);
 }
 
 TEST(FourDofIcpTest, SingleWallLeavesTheMotionAlongItFree) {
@@ -230,7 +229,7 @@ TEST(FourDofIcpTest, NonFinitePointsAreSkippedAndCounted) {
   EXPECT_EQ(r.skipped_source, nan_source);
   const Eigen::Vector4d e = Error(r.T_a_b, kTruth);
   EXPECT_LT(e.head<3>().norm(), 1e-3);
-  EXPECT_LT(std::abs(e(3)), 0.01 * kDeg);
+  EXPECT_LT(std::abs(e(3)), 0.01 * kDegree);
   EXPECT_TRUE(r.covariance.allFinite());
 }
 

@@ -16,7 +16,7 @@ using KdSearchParams = nanoflann::SearchParameters;
 using KdSearchParams = nanoflann::SearchParams;
 #endif
 
-struct PointsAdaptor {
+struct ShotCloudAdaptor {
   const std::vector<Eigen::Vector3f>* points = nullptr;
   size_t kdtree_get_point_count() const { return points->size(); }
   float kdtree_get_pt(uint32_t i, size_t dim) const { return (*points)[i][static_cast<Eigen::Index>(dim)]; }
@@ -26,8 +26,8 @@ struct PointsAdaptor {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, PointsAdaptor>,
-                                                   PointsAdaptor, 3, uint32_t>;
+using ShotKdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, ShotCloudAdaptor>,
+                                                   ShotCloudAdaptor, 3, uint32_t>;
 
 // Radius search results into buffers owned by the caller, which stop allocating once grown.
 class RadiusCollector {
@@ -162,8 +162,8 @@ struct GravityShotDescriptor::Impl {
   std::vector<Eigen::Vector3f> normals;
   std::vector<uint8_t> normal_state;  // kUnknown, kValid, kNone
   int64_t non_finite = 0;
-  PointsAdaptor adaptor;
-  std::unique_ptr<KdTree> tree;
+  ShotCloudAdaptor adaptor;
+  std::unique_ptr<ShotKdTree> tree;
   // Scratch reused by every search.
   std::vector<uint32_t> support, neighbours;
   std::vector<float> support_d2, neighbour_d2, support_d;
@@ -394,7 +394,7 @@ GravityShotDescriptor::GravityShotDescriptor(const std::vector<CloudPoint>& clou
   m.normals.resize(m.points.size());
   m.normal_state.assign(m.points.size(), Impl::kUnknown);
   m.adaptor.points = &m.points;
-  m.tree = std::make_unique<KdTree>(3, m.adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  m.tree = std::make_unique<ShotKdTree>(3, m.adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16));
 }
 
 GravityShotDescriptor::~GravityShotDescriptor() = default;

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "mapping/matching/submap_feature_extractor.h"
+#include "common/angles.h"
 #include "mapping/matching/submap_matcher.h"
 #include "mapping/testing/real_scan.h"
 #include "mapping/testing/rock_field_scene.h"
@@ -17,8 +18,6 @@
 
 namespace cairn {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 class RealScanMatchTest : public ::testing::Test {
  protected:
@@ -70,9 +69,9 @@ TEST_F(RealScanMatchTest, OverlappingCropsMatchToTheirRelativePose) {
     ASSERT_TRUE(r.matched()) << r.reason;
     const double dt = (r.T_a_b.translation() - truth.translation()).norm();
     const double dyaw = std::abs(WrapAngle(r.T_a_b.yaw() - truth.yaw()));
-    std::printf("[ match   ] real scan: error %.4f m, %.4f deg\n", dt, dyaw / kDeg);
+    std::printf("[ match   ] real scan: error %.4f m, %.4f deg\n", dt, dyaw / kDegree);
     EXPECT_LT(dt, 0.01);
-    EXPECT_LT(dyaw, 0.1 * kDeg);
+    EXPECT_LT(dyaw, 0.1 * kDegree);
   }
 }
 

@@ -2,16 +2,10 @@
 
 #include <chrono>
 
+#include "common/elapsed.h"
 #include "common/heap_bytes.h"
 
 namespace cairn {
-namespace {
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
-
-}  // namespace
 
 size_t SubmapFeatures::memory_bytes() const {
   return sizeof(*this) + HeapBytes(keypoints.points, keypoints.known_fraction, described.points, described.descriptors,
@@ -33,7 +27,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
     f.keypoints = KeypointExtractor(options_.keypoints).Extract(submap);
     f.suitability = suitability.Check(submap, f.keypoints.points);
   }
-  f.keypoint_ms = MsSince(start);
+  f.keypoint_ms = MillisecondsSince(start);
   if (!f.suitability.suitable()) {
     // Never aligned, but kept for the whole mission: most submaps of a rover on open ground.
     f.cloud = std::vector<Eigen::Vector3d>();  // frees it (assigning {} would keep the capacity)
@@ -43,7 +37,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   const auto describe_start = std::chrono::steady_clock::now();
   GravityShotDescriptor descriptor(submap.points(), options_.descriptor);
   f.described = descriptor.ComputeAll(f.keypoints.points);
-  f.descriptor_ms = MsSince(describe_start);
+  f.descriptor_ms = MillisecondsSince(describe_start);
   return f;
 }
 

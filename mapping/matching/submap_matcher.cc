@@ -6,14 +6,12 @@
 #include <cstdio>
 #include <vector>
 
+#include "common/elapsed.h"
+
 namespace cairn {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 std::string Format(const char* format, auto... args) {
   char buffer[256];
@@ -107,7 +105,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   auto finish = [&](MatchStatus status, std::string reason) {
     r.status = status;
     r.reason = std::move(reason);
-    r.times.total_ms = MsSince(start);
+    r.times.total_ms = MillisecondsSince(start);
     return r;
   };
   if (Status s = options_.Validate(); !s.ok()) return finish(MatchStatus::kNoMatch, s.message());
@@ -119,11 +117,11 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   const std::vector<KeypointCorrespondence> correspondences =
       CorrespondenceFinder(options_.correspondences).Find(a.described.descriptors, b.described.descriptors);
   r.correspondences = correspondences.size();
-  r.times.correspondences_ms = MsSince(stage);
+  r.times.correspondences_ms = MillisecondsSince(stage);
   stage = Clock::now();
   const HoughResult votes = HoughVoting(options_.hough).Vote(a.described, b.described, correspondences);
   r.clusters = votes.clusters.size();
-  r.times.hough_ms = MsSince(stage);
+  r.times.hough_ms = MillisecondsSince(stage);
   if (votes.clusters.empty())
     return finish(MatchStatus::kNoMatch, Format("%zu correspondences, no vote cluster", correspondences.size()));
 
@@ -187,7 +185,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     }
     hypotheses.push_back(std::move(h));
   }
-  r.times.ransac_ms = MsSince(stage);
+  r.times.ransac_ms = MillisecondsSince(stage);
   if (hypotheses.empty())
     return finish(MatchStatus::kNoMatch, rejections.Summary("no cluster reached a RANSAC consensus"));
   std::stable_sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& x, const Hypothesis& y) {
@@ -228,13 +226,13 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       r.covariance = fit.covariance;
       const double ft = options_.covariance_floor_translation, fy = options_.covariance_floor_yaw;
       r.covariance.diagonal() += Eigen::Vector4d(ft * ft, ft * ft, ft * ft, fy * fy);
-      r.times.icp_ms = MsSince(stage);
+      r.times.icp_ms = MillisecondsSince(stage);
       return finish(MatchStatus::kMatched,
                     Format("%zu RANSAC inliers of %zu correspondences; icp %zu pairs, rms %.4f m", h.inliers,
                            correspondences.size(), fit.inliers, fit.rms));
     }
   }
-  r.times.icp_ms = MsSince(stage);
+  r.times.icp_ms = MillisecondsSince(stage);
   return finish(MatchStatus::kNoMatch, rejections.Summary("no hypothesis refined"));
 }
 

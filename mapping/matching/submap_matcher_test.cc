@@ -10,14 +10,13 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "mapping/matching/submap_feature_extractor.h"
 #include "mapping/submap_codec.h"
 #include "mapping/testing/rock_field_scene.h"
 
 namespace cairn {
 namespace {
-
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Truth {
   FourDofTransform T_a_b;
@@ -76,7 +75,7 @@ TEST_F(SubmapMatcherTest, RecoversTheTrueTransformWithoutAGuess) {
   ASSERT_TRUE(r.matched()) << r.reason;
   const FourDofTransform truth = TruthOf(*pair_).T_a_b;
   EXPECT_LT((r.T_a_b.translation() - truth.translation()).norm(), 0.05);
-  EXPECT_LT(YawError(r.T_a_b, truth), 0.5 * kDeg);
+  EXPECT_LT(YawError(r.T_a_b, truth), 0.5 * kDegree);
   // The covariance is a covariance: symmetric, positive definite.
   EXPECT_TRUE(r.covariance.isApprox(r.covariance.transpose()));
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(r.covariance).eigenvalues().minCoeff(), 0.0);
@@ -88,7 +87,7 @@ TEST_F(SubmapMatcherTest, MatchesTheOtherWayRoundToTheInverse) {
   ASSERT_TRUE(ab.matched() && ba.matched()) << ab.reason << " / " << ba.reason;
   const FourDofTransform loop = ab.T_a_b * ba.T_a_b;
   EXPECT_LT(loop.translation().norm(), 0.05);
-  EXPECT_LT(std::abs(loop.yaw()), 0.5 * kDeg);
+  EXPECT_LT(std::abs(loop.yaw()), 0.5 * kDegree);
 }
 
 TEST_F(SubmapMatcherTest, AGoodRelativeEstimateKeepsTheMatch) {
@@ -162,7 +161,7 @@ TEST(SubmapMatcherSceneTest, SubmapsFromTheWireMatchAsPreciselyAsTheOriginals) {
       ASSERT_TRUE(r.matched()) << "seed " << seed << (on_wire ? " from the wire" : "") << ": " << r.reason;
       const FourDofTransform e = truth.T_a_b.inverse() * r.T_a_b;
       EXPECT_LT(e.translation().norm(), 0.01) << "seed " << seed;
-      EXPECT_LT(YawError(r.T_a_b, truth.T_a_b), 0.1 * kDeg) << "seed " << seed;
+      EXPECT_LT(YawError(r.T_a_b, truth.T_a_b), 0.1 * kDegree) << "seed " << seed;
       sum2[on_wire] += e.translation().squaredNorm();
     }
   }
