@@ -5,9 +5,31 @@
 #include "common/heap_bytes.h"
 
 namespace cairn {
+namespace {
+
+// Every OctoMap tree keeps a 600 KB key buffer for casting rays; a finished submap's tree casts
+// none (it is const from here on), and a long mission keeps hundreds of them.
+std::unique_ptr<const octomap::OcTree> WithoutRayBuffers(std::unique_ptr<octomap::OcTree> tree) {
+  tree->clearKeyRays();
+  return tree;
+}
+
+// The heap blocks the tree's nodes and children arrays take, which are larger than OctoMap's own
+// count of their sizes (memoryUsage()).
+size_t TreeHeapBytes(const octomap::OcTree& tree) {
+  const size_t nodes = tree.size();
+  const size_t inner = nodes - tree.getNumLeafNodes();
+  return sizeof(tree) + nodes * HeapBlockBytes(sizeof(octomap::OcTreeNode)) +
+         inner * HeapBlockBytes(8 * sizeof(octomap::OcTreeNode*));
+}
+
+}  // namespace
 
 Submap::Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree)
-    : metadata_(std::move(metadata)), points_(std::move(points)), tree_(std::move(tree)) {}
+    : metadata_(std::move(metadata)),
+      points_(std::move(points)),
+      tree_(WithoutRayBuffers(std::move(tree))),
+      tree_bytes_(TreeHeapBytes(*tree_)) {}
 
 int64_t Submap::obstacle_points() const {
   int64_t n = 0;
@@ -16,7 +38,7 @@ int64_t Submap::obstacle_points() const {
 }
 
 size_t Submap::memory_bytes() const {
-  return sizeof(*this) + HeapBytes(points_) + (tree_ != nullptr ? tree_->memoryUsage() : 0);
+  return sizeof(*this) + HeapBytes(points_) + tree_bytes_;
 }
 
 OpenSubmap::OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id)

@@ -35,13 +35,14 @@ class Submap {
   const std::vector<CloudPoint>& points() const { return points_; }
   const octomap::OcTree& tree() const { return *tree_; }
   int64_t obstacle_points() const;
-  // Heap held: the cloud and the octree (OctoMap's own count of its nodes).
+  // Heap held: the cloud and the octree's heap blocks.
   size_t memory_bytes() const;
 
  private:
   SubmapMetadata metadata_;
   std::vector<CloudPoint> points_;
   std::unique_ptr<const octomap::OcTree> tree_;
+  size_t tree_bytes_ = 0;
 };
 
 class OpenSubmap {

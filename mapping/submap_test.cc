@@ -1,6 +1,11 @@
 #include "mapping/submap.h"
 
+#include <malloc.h>
+
 #include <gtest/gtest.h>
+
+#include "common/heap_bytes.h"
+#include "common/sanitizers.h"
 
 namespace cairn {
 namespace {
@@ -51,6 +56,32 @@ TEST(OpenSubmapTest, RestartOfAnUnusedSubmapOnlyRenamesIt) {
   OccupancyIntegrator integ(0.1, 8.0);
   open.Integrate(OnePoint(1.05f), &integ);
   EXPECT_EQ(open.Finish()->metadata().id, 9u);
+}
+
+// A finished submap's tree casts no rays: OctoMap's ray buffer goes, and what the submap reports
+// holding is what the heap holds for it.
+TEST(SubmapTest, FinishedTreeKeepsNoRayBufferAndCountsItsHeapBlocks) {
+  if (CAIRN_ADDRESS_SANITIZER || CAIRN_THREAD_SANITIZER) GTEST_SKIP() << "the sanitizer replaces malloc";
+  SubmapOptions so;
+  OccupancyIntegrator integ(0.1, 8.0);
+  std::vector<CloudPoint> points(100);
+  const size_t before = mallinfo2().uordblks;
+  auto tree = MakeOccupancyTree(so);
+  const size_t with_buffer = mallinfo2().uordblks;
+  for (int i = 0; i < 200; ++i) {
+    tree->updateNode(octomap::point3d(0.1f * static_cast<float>(i % 20), 0.1f * static_cast<float>(i / 20), 0.0f), true);
+  }
+  const size_t nodes_before = mallinfo2().uordblks;
+  const size_t tree_nodes = tree->size();
+  const Submap submap(SubmapMetadata{}, points, std::move(tree));
+  const size_t after = mallinfo2().uordblks;
+  EXPECT_GT(with_buffer - before, size_t{500000});      // the ray buffer of a new tree
+  EXPECT_GT(nodes_before - after, size_t{500000});      // gone once the submap is finished
+  EXPECT_EQ(submap.tree().size(), tree_nodes);
+  // The submap's count against the heap it holds (its tree and points; `points` was copied).
+  const double held = static_cast<double>(after - before);
+  EXPECT_NEAR(static_cast<double>(submap.memory_bytes()), held, 0.05 * held + 512);
+  EXPECT_GT(submap.memory_bytes(), tree_nodes * HeapBlockBytes(sizeof(octomap::OcTreeNode)));
 }
 
 }  // namespace
