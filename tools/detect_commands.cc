@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/elapsed.h"
 #include "common/json_writer.h"
 #include "detection/tag_detector.h"
 #include "detection/tag_pose_estimator.h"
@@ -41,10 +42,6 @@ void WriteMatrix(JsonWriter& j, const char* key, const Eigen::MatrixXd& m) {
 
 // A view of a continuous 8-bit gray cv::Mat (which must outlive it).
 Image GrayView(const cv::Mat& m) { return Image::GrayView(m.data, m.cols, m.rows, static_cast<int>(m.step[0])); }
-
-double MsSince(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
 
 }  // namespace
 
@@ -142,7 +139,7 @@ int RunDetect(const CommandArgs& args) {
   TagDetector detector(detector_options);
   const auto start = std::chrono::steady_clock::now();
   const auto found = detector.Detect(GrayView(gray));
-  const double detect_ms = MsSince(start);
+  const double detect_ms = MillisecondsSince(start);
   if (!found.ok()) {
     std::fprintf(stderr, "cairn detect: %s: %s\n", image_path.c_str(), found.status().ToString().c_str());
     return 1;

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "common/angles.h"
+#include "mapping/matching/four_dof_transform.h"
 #include "mapping/matching/keypoint_extractor.h"
 #include "mapping/testing/rock_field_scene.h"
 
@@ -61,7 +61,7 @@ TEST(GravityShotDescriptorTest, InvariantToYaw) {
       const double dist = GravityShotDescriptor::Distance(d0.descriptors[i], d);
       worst = std::max(worst, dist);
       if (dist < 1e-3) ++same;
-      if (std::abs(AngleDifference(f.yaw - d0.frames[i].yaw, yaw)) < 1e-3) ++same_yaw;
+      if (std::abs(WrapAngle(f.yaw - d0.frames[i].yaw - yaw)) < 1e-3) ++same_yaw;
     }
     std::printf(
         "[ yaw     ] turned by %.1f rad: %d of %d descriptors within 0.001 (worst %.4f), %d frames turned by "
@@ -109,7 +109,7 @@ TEST(GravityShotDescriptorTest, SamePlaceIsNearestAcrossSubmaps) {
     }
     const bool hit = best == i;
     top1 += hit ? 1 : 0;
-    if (std::abs(AngleDifference(fb[i].yaw - fa[i].yaw, true_yaw)) < 0.2) ++yaw_ok;
+    if (std::abs(WrapAngle(fb[i].yaw - fa[i].yaw - true_yaw)) < 0.2) ++yaw_ok;
     // Well supported: a dense sphere with a clear horizontal direction.
     if (fa[i].support >= 60 && fa[i].slope >= 0.3f) {
       ++well;

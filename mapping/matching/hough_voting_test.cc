@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "common/angles.h"
 #include "mapping/matching/correspondence_finder.h"
+#include "mapping/matching/four_dof_transform.h"
 #include "mapping/matching/gravity_shot_descriptor.h"
 #include "mapping/matching/keypoint_extractor.h"
 #include "mapping/testing/rock_field_scene.h"
@@ -46,7 +46,7 @@ TEST(HoughVotingTest, StrongestClusterHoldsTheConsistentPairs) {
   const HoughResult r = HoughVoting().Vote(a, b, c);
   ASSERT_FALSE(r.clusters.empty());
   const HoughCluster& best = r.clusters.front();
-  EXPECT_LT(std::abs(AngleDifference(best.yaw_b_a, yaw)), 0.05);
+  EXPECT_LT(std::abs(WrapAngle(best.yaw_b_a - yaw)), 0.05);
   EXPECT_LT((best.t_b_a - T_b_a.translation()).norm(), 0.2f);
   bool both_ways[2] = {false, false};
   for (const HoughCluster& cl : r.clusters) both_ways[cl.a_in_b ? 0 : 1] = true;
@@ -106,9 +106,9 @@ TEST(HoughVotingTest, KeepsMostlyTruePairsOfTwoSubmaps) {
   const double true_yaw = std::atan2(T_b_a.linear()(1, 0), T_b_a.linear()(0, 0));
   std::printf(
       "[ match   ] strongest cluster: %zu pairs, %.1f votes, yaw error %.3f rad, translation error %.3f m\n",
-      best.members.size(), best.votes, AngleDifference(best.yaw_b_a, true_yaw),
+      best.members.size(), best.votes, WrapAngle(best.yaw_b_a - true_yaw),
       (best.t_b_a - T_b_a.translation()).norm());
-  EXPECT_LT(std::abs(AngleDifference(best.yaw_b_a, true_yaw)), 0.1);
+  EXPECT_LT(std::abs(WrapAngle(best.yaw_b_a - true_yaw)), 0.1);
   EXPECT_LT((best.t_b_a - T_b_a.translation()).norm(), 0.3f);
   EXPECT_GE(ratio(r.candidates, 0.2f), 0.5);
 
