@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/sanitizers.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
 
@@ -22,7 +23,7 @@ ProcessResult Probe(const std::string& fault) {
 class SanitizersTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (std::string(CAIRN_SANITIZER_BUILD) != "address") {
+    if (!CAIRN_ADDRESS_SANITIZER) {
       GTEST_SKIP() << "not an AddressSanitizer + UBSan build (the asan-ubsan preset runs this)";
     }
   }
