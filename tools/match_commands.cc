@@ -138,6 +138,7 @@ int RunBenchMatch(const CommandArgs& args) {
   std::vector<std::string> dirs;
   double min_overlap = 0.3;
   std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
+  SubmapMatcherOptions matcher_options;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     std::vector<double> v;
@@ -147,13 +148,17 @@ int RunBenchMatch(const CommandArgs& args) {
     } else if (a == "--wire-bits" && i + 1 < args.args.size() && ParseList(args.args[i + 1], 2, &v)) {
       wire_bits = v;
       ++i;
+    } else if (a == "--no-photometric") {
+      matcher_options.min_hypothesis_ncc = matcher_options.min_match_ncc = -1.0;
     } else if (a.empty() || a[0] == '-') {
       std::fprintf(
           stderr,
           "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
+          "                         [--no-photometric]\n"
           "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
           "  --wire-bits: first send every submap through the wire format at these bit counts\n"
-          "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n");
+          "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
+          "  --no-photometric: geometry only, the keypoint spread check on every hypothesis (thesis 6.1)\n");
       return 2;
     } else {
       dirs.push_back(a);
@@ -199,7 +204,7 @@ int RunBenchMatch(const CommandArgs& args) {
               dirs.size(), suitable);
   std::printf("  keypoints + descriptors per submap: median %.1f ms, max %.1f ms\n", Median(feature_ms),
               feature_ms.empty() ? NAN : *std::max_element(feature_ms.begin(), feature_ms.end()));
-  const SubmapMatcher matcher;
+  const SubmapMatcher matcher(matcher_options);
   std::vector<double> match_ms, good_error_m, good_error_deg;
   size_t positives = 0, found = 0, matched = 0, correct = 0, negatives = 0, false_matches = 0;
   for (size_t i = 0; i < submaps.size(); ++i) {
@@ -232,7 +237,8 @@ int RunBenchMatch(const CommandArgs& args) {
                   b.robot.c_str(), static_cast<unsigned long long>(b.id), 100.0 * overlap,
                   std::string(MatchStatusName(r.status)).c_str());
       if (r.matched()) {
-        std::printf(" error %.3f m %.2f deg", error.translation().norm(), std::abs(error.yaw()) * 180 / M_PI);
+        std::printf(" error %.3f m %.2f deg, grey levels %.3f", error.translation().norm(),
+                    std::abs(error.yaw()) * 180 / M_PI, r.photometric.ncc);
       } else {
         std::printf(" (%s)", r.reason.c_str());
       }
@@ -333,6 +339,8 @@ int RunMatch(const CommandArgs& args) {
   j.Field("gated_out", r.gated_out).Field("spread_rejected", r.spread_rejected).Field("refined", r.refined);
   j.Field("ransac_inliers", r.ransac_inliers).Field("icp_inliers", r.icp_inliers);
   j.Field("icp_rms", r.icp_rms).Field("icp_iterations", r.icp_iterations);
+  j.Field("photometric_rejected", r.photometric_rejected).Field("grey_pairs", r.photometric.pairs);
+  j.Field("grey_correlation", r.photometric.ncc);  // null where the grey levels could not judge
   j.EndObject();
   j.Key("time_ms").BeginObject();
   j.Field("keypoints", fa.keypoint_ms + fb.keypoint_ms).Field("descriptors", fa.descriptor_ms + fb.descriptor_ms);

@@ -9,7 +9,7 @@ namespace cairn {
 
 size_t SubmapFeatures::memory_bytes() const {
   return sizeof(*this) + HeapBytes(keypoints.points, keypoints.known_fraction, described.points, described.descriptors,
-                                   described.frames, described.keypoint_index, cloud);
+                                   described.frames, described.keypoint_index, cloud, cloud_grey);
 }
 
 SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
@@ -18,9 +18,11 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   const SubmapSuitability suitability(options_.suitability);
   f.suitability = suitability.CheckCloud(submap.points());
   f.cloud.reserve(static_cast<size_t>(f.suitability.points));
+  f.cloud_grey.reserve(static_cast<size_t>(f.suitability.points));
   for (const CloudPoint& c : submap.points()) {
     if (!c.p.allFinite()) continue;
     f.cloud.push_back(c.p.cast<double>());
+    f.cloud_grey.push_back(static_cast<float>(c.r + c.g + c.b) / 3.0f);
     if (c.obstacle) f.obstacle_box_xy.extend(c.p.head<2>().cast<double>());
   }
   if (f.suitability.suitable()) {
@@ -31,6 +33,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   if (!f.suitability.suitable()) {
     // Never aligned, but kept for the whole mission: most submaps of a rover on open ground.
     f.cloud = std::vector<Eigen::Vector3d>();  // frees it (assigning {} would keep the capacity)
+    f.cloud_grey = std::vector<float>();
     return f;
   }
 

@@ -1,7 +1,8 @@
 #pragma once
 // What the matcher needs of one submap, computed once and reused for every pair it is in (thesis
 // 6.1.1, 6.1.2): the suitability verdict, keypoints, their descriptors, the finite cloud for the
-// ICP and the xy box of the obstacle points for pairing.
+// ICP with its grey levels for the photometric check, and the xy box of the obstacle points for
+// pairing.
 
 #include <cstdint>
 #include <vector>
@@ -34,6 +35,7 @@ struct SubmapFeatures {
   SubmapKeypoints keypoints;
   DescribedKeypoints described;         // empty for an unsuitable submap
   std::vector<Eigen::Vector3d> cloud;   // finite cloud points, submap frame; empty when unsuitable
+  std::vector<float> cloud_grey;        // each cloud point's grey level (mean of r, g, b)
   // xy extent of the finite obstacle points (submap frame); empty when there are none.
   Eigen::AlignedBox2d obstacle_box_xy;
   double keypoint_ms = 0.0;    // keypoints, known-space filter and suitability

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 #include "common/elapsed.h"
@@ -24,6 +25,7 @@ struct Hypothesis {
   std::vector<uint32_t> a_keypoints, b_keypoints;  // of the RANSAC inliers
   size_t inliers = 0;
   double rms = 0.0;
+  bool grey_agreed = false;  // the photometric check judged it and it passed
 };
 
 // Counts rejections by kind and keeps the first message of each, so a failed attempt says how
@@ -57,6 +59,26 @@ class Rejections {
   std::vector<Entry> entries_;
 };
 
+enum class Verdict { kAgree, kDisagree, kUndecided };
+
+// What a photometric score says against `min_ncc`: undecided with too few points compared or no
+// texture on one side (`why` says which), else whether the correlation reaches it.
+Verdict JudgeGrey(const PhotometricScore& score, double min_ncc, int64_t min_pairs, std::string* why) {
+  if (static_cast<int64_t>(score.pairs) < min_pairs) {
+    *why = Format("grey levels compared at %zu points, fewer than %lld", score.pairs, static_cast<long long>(min_pairs));
+    return Verdict::kUndecided;
+  }
+  if (!std::isfinite(score.ncc)) {
+    *why = Format("no grey-level texture at the %zu points compared", score.pairs);
+    return Verdict::kUndecided;
+  }
+  if (score.ncc < min_ncc) {
+    *why = Format("grey levels correlate %.3f at %zu points, below %.3f", score.ncc, score.pairs, min_ncc);
+    return Verdict::kDisagree;
+  }
+  return Verdict::kAgree;
+}
+
 }  // namespace
 
 std::string_view MatchStatusName(MatchStatus status) {
@@ -76,6 +98,7 @@ Status SubmapMatcherOptions::Validate() const {
   if (Status s = icp.Validate(); !s.ok()) return s;
   if (!(gate_sigmas > 0.0)) return InvalidArgumentError("matcher: gate_sigmas must be > 0");
   if (max_refined_hypotheses < 1) return InvalidArgumentError("matcher: max_refined_hypotheses must be >= 1");
+  if (!(photometric_voxel > 0.0)) return InvalidArgumentError("matcher: photometric_voxel must be > 0");
   return Status::Ok();
 }
 
@@ -135,6 +158,33 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   Rejections rejections;
   std::vector<Eigen::Vector3d> source_b, target_a;
   std::vector<Eigen::Vector3f> inlier_points;
+  std::optional<PhotometricAgreement> photometric;  // A's grey levels, built for the first check
+  PhotometricScore last_grey;
+  const auto Judge = [&](double min_ncc, const FourDofTransform& T_a_b, std::string* why) {
+    if (min_ncc <= -1.0) {
+      last_grey = PhotometricScore{};
+      *why = "grey levels not checked";
+      return Verdict::kUndecided;
+    }
+    if (!photometric) photometric.emplace(a.cloud, a.cloud_grey, options_.photometric_voxel);
+    last_grey = photometric->Score(b.cloud, b.cloud_grey, T_a_b);
+    return JudgeGrey(last_grey, min_ncc, options_.min_photometric_pairs, why);
+  };
+  const auto SpreadOk = [&](const Hypothesis& h, std::string* why) {
+    for (const auto* side : {&a, &b}) {
+      if (options_.min_off_line_inliers <= 0) break;
+      const std::vector<uint32_t>& ids = side == &a ? h.a_keypoints : h.b_keypoints;
+      inlier_points.clear();
+      for (const uint32_t id : ids) inlier_points.push_back(side->described.points[id]);
+      const int64_t off = spread.OffLineKeypoints(inlier_points);
+      if (off < options_.min_off_line_inliers) {
+        *why = Format("keypoints on a line: %lld of %zu off it in submap %s, need %lld", static_cast<long long>(off),
+                      ids.size(), side == &a ? "A" : "B", static_cast<long long>(options_.min_off_line_inliers));
+        return false;
+      }
+    }
+    return true;
+  };
   for (const HoughCluster& cluster : votes.clusters) {
     source_b.clear();
     target_a.clear();
@@ -165,22 +215,18 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       rejections.Add("hypotheses outside the gate", "hypothesis " + why);
       continue;
     }
-    bool spread_ok = true;
-    for (const auto* side : {&a, &b}) {
-      const std::vector<uint32_t>& ids = side == &a ? h.a_keypoints : h.b_keypoints;
-      inlier_points.clear();
-      for (const uint32_t id : ids) inlier_points.push_back(side->described.points[id]);
-      const int64_t off = spread.OffLineKeypoints(inlier_points);
-      if (off < options_.min_off_line_inliers) {
-        spread_ok = false;
-        rejections.Add("hypotheses with keypoints on a line", Format("hypothesis keypoints on a line: %lld of %zu off it in submap %s, need %lld",
-                                static_cast<long long>(off), ids.size(), side == &a ? "A" : "B",
-                                static_cast<long long>(options_.min_off_line_inliers)));
-        break;
-      }
+    // The grey levels judge the hypothesis where they can; where they cannot (no texture, little
+    // overlap, the check off) the spread of its keypoints must rule out a slide along a line.
+    const Verdict grey = Judge(options_.min_hypothesis_ncc, h.T_a_b, &why);
+    if (grey == Verdict::kDisagree) {
+      ++r.photometric_rejected;
+      rejections.Add("hypotheses whose grey levels disagree", "hypothesis: " + why);
+      continue;
     }
-    if (!spread_ok) {
+    h.grey_agreed = grey == Verdict::kAgree;
+    if (!h.grey_agreed && !SpreadOk(h, &why)) {
       ++r.spread_rejected;
+      rejections.Add("hypotheses with keypoints on a line", "hypothesis " + why);
       continue;
     }
     hypotheses.push_back(std::move(h));
@@ -221,7 +267,15 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
                                                           static_cast<long long>(options_.min_icp_inliers)));
     } else if (prior.has_value() && !WithinGate(fit.T_a_b, *prior, &why)) {
       rejections.Add("refinements outside the gate", "refined match " + why);
+    } else if (const Verdict grey = Judge(options_.min_match_ncc, fit.T_a_b, &why); grey == Verdict::kDisagree) {
+      ++r.photometric_rejected;
+      r.photometric = last_grey;
+      rejections.Add("refinements whose grey levels disagree", "refined match: " + why);
+    } else if (grey == Verdict::kUndecided && h.grey_agreed && !SpreadOk(h, &why)) {
+      ++r.spread_rejected;
+      rejections.Add("refinements with keypoints on a line", "refined match: " + why);
     } else {
+      r.photometric = last_grey;
       r.T_a_b = fit.T_a_b;
       r.covariance = fit.covariance;
       const double ft = options_.covariance_floor_translation, fy = options_.covariance_floor_yaw;
@@ -229,7 +283,9 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       r.times.icp_ms = MillisecondsSince(stage);
       return finish(MatchStatus::kMatched,
                     Format("%zu RANSAC inliers of %zu correspondences; icp %zu pairs, rms %.4f m", h.inliers,
-                           correspondences.size(), fit.inliers, fit.rms));
+                           correspondences.size(), fit.inliers, fit.rms) +
+                        (grey == Verdict::kAgree ? Format("; grey levels correlate %.3f", r.photometric.ncc)
+                                                 : "; " + why + ": geometry only"));
     }
   }
   r.times.icp_ms = MillisecondsSince(stage);

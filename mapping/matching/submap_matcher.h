@@ -1,8 +1,9 @@
 #pragma once
 // Pairwise matching of two gravity-aligned submaps (thesis 6.1.2): descriptor correspondences,
 // Hough voting both ways, a 4-DoF RANSAC per vote cluster, the gate against the graph's relative
-// estimate, the spread check of each hypothesis' keypoints, then point-to-plane 4-DoF ICP on the
-// full clouds from the best surviving hypothesis, gated again.
+// estimate, the spread check of each hypothesis' keypoints, the photometric check of each
+// hypothesis (photometric_agreement.h), then point-to-plane 4-DoF ICP on the full clouds from the
+// best surviving hypothesis, gated and checked photometrically again.
 //
 // The result is T_a_b (B's origin in A's frame) with its covariance from the ICP (x, y, z, yaw,
 // see four_dof_icp.h). Every rejection says which check failed and by how much, because matches
@@ -22,6 +23,7 @@
 #include "mapping/matching/four_dof_ransac.h"
 #include "mapping/matching/four_dof_transform.h"
 #include "mapping/matching/hough_voting.h"
+#include "mapping/matching/photometric_agreement.h"
 #include "mapping/matching/submap_feature_extractor.h"
 
 namespace cairn {
@@ -38,7 +40,11 @@ struct SubmapMatcherOptions {
   double gate_floor_translation = 0.05;  // m
   double gate_floor_yaw = 0.01;          // rad
   // Spread check of a hypothesis' inlier keypoints, in each submap: at least this many farther
-  // than off_line_distance (xy) from the line through them that leaves the fewest off it.
+  // than off_line_distance (xy) from the line through them that leaves the fewest off it (thesis:
+  // 2). Applied only where the photometric check below cannot judge (no grey-level texture, too
+  // few points compared, the check off): where it can, it refuses what the spread check guards
+  // against (alignments that slide along a ridge or turn about a crater's rim) without refusing
+  // the true matches whose keypoints all lie on such a rim, as most do on smooth ground.
   int64_t min_off_line_inliers = 2;
   double off_line_distance = 0.5;  // m
   // ICP results refused: too far from the hypothesis it started from (it left the hypothesis'
@@ -49,6 +55,13 @@ struct SubmapMatcherOptions {
   int64_t min_icp_inliers = 300;
   // Hypotheses refined by the ICP, best first, until one is accepted.
   int64_t max_refined_hypotheses = 2;
+  // Photometric check: the correlation of B's grey levels with A's in the same `photometric_voxel`
+  // under a hypothesis (before the ICP; the cheap way to drop wrong ones) and under the refined
+  // match, where at least `min_photometric_pairs` points are compared. -1 turns a check off.
+  double photometric_voxel = 0.05;  // m
+  double min_hypothesis_ncc = 0.7;
+  double min_match_ncc = 0.9;
+  int64_t min_photometric_pairs = 500;
   // Added (as variances) to the ICP's covariance, which treats every residual as independent: the
   // errors the clouds' points share (each a centroid in a 0.05 m voxel, about 0.014 m RMS, and the
   // stereo calibration) do not average out over thousands of pairs.
@@ -70,6 +83,10 @@ struct SubmapMatcherOptions {
     v.Number("max_icp_rms", max_icp_rms, 1e-4, 10.0, "m");
     v.Integer("min_icp_inliers", min_icp_inliers, 5, 100'000'000, "pairs");
     v.Integer("max_refined_hypotheses", max_refined_hypotheses, 1, 100, "");
+    v.Number("photometric_voxel", photometric_voxel, 0.001, 10.0, "m");
+    v.Number("min_hypothesis_ncc", min_hypothesis_ncc, -1.0, 1.0, "correlation");
+    v.Number("min_match_ncc", min_match_ncc, -1.0, 1.0, "correlation");
+    v.Integer("min_photometric_pairs", min_photometric_pairs, 2, 100'000'000, "points");
     v.Number("covariance_floor_translation", covariance_floor_translation, 0.0, 10.0, "m");
     v.Number("covariance_floor_yaw", covariance_floor_yaw, 0.0, 1.0, "rad");
   }
@@ -104,11 +121,13 @@ struct SubmapMatchResult {
   size_t hypotheses = 0;       // clusters whose RANSAC reached a consensus
   size_t gated_out = 0;        // hypotheses outside the gate
   size_t spread_rejected = 0;  // hypotheses whose keypoints lie on a line
+  size_t photometric_rejected = 0;  // hypotheses and refinements whose grey levels disagree
   size_t refined = 0;          // hypotheses handed to the ICP
   size_t ransac_inliers = 0;   // of the hypothesis the match came from
   size_t icp_inliers = 0;
   double icp_rms = 0.0;
   int64_t icp_iterations = 0;
+  PhotometricScore photometric;  // of the match, or of the last refinement tried
   MatchStageTimes times;
 
   bool matched() const { return status == MatchStatus::kMatched; }

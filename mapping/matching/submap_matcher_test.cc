@@ -5,6 +5,8 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include <random>
+#include <algorithm>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -115,6 +117,39 @@ TEST_F(SubmapMatcherTest, AConfidentWrongEstimateGatesTheMatchOut) {
     EXPECT_NE(r.reason.find(std::to_string(r.gated_out) + " hypotheses outside the gate"), std::string::npos)
         << r.reason;
   }
+}
+
+// Geometry that fits but a ground pattern that does not (here B's grey levels scrambled, as if
+// another place of the same shape) is refused, before and after the ICP; with both photometric
+// checks off the geometry alone matches.
+TEST_F(SubmapMatcherTest, GreyLevelsThatDisagreeRefuseTheMatch) {
+  SubmapFeatures scrambled = *features_b_;
+  std::mt19937 rng(5);
+  std::shuffle(scrambled.cloud_grey.begin(), scrambled.cloud_grey.end(), rng);
+  SubmapMatchResult r = SubmapMatcher().Match(*features_a_, scrambled);
+  Print("scrambled grey", r);
+  EXPECT_EQ(r.status, MatchStatus::kNoMatch);
+  EXPECT_GT(r.photometric_rejected, 0u);
+  EXPECT_NE(r.reason.find("grey levels correlate"), std::string::npos) << r.reason;
+
+  SubmapMatcherOptions after_icp_only;
+  after_icp_only.min_hypothesis_ncc = -1.0;
+  r = SubmapMatcher(after_icp_only).Match(*features_a_, scrambled);
+  EXPECT_EQ(r.status, MatchStatus::kNoMatch);
+  EXPECT_NE(r.reason.find("refinements whose grey levels disagree"), std::string::npos) << r.reason;
+  EXPECT_LT(std::abs(r.photometric.ncc), 0.3);
+
+  SubmapMatcherOptions off = after_icp_only;
+  off.min_match_ncc = -1.0;
+  r = SubmapMatcher(off).Match(*features_a_, scrambled);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_LT((r.T_a_b.translation() - TruthOf(*pair_).T_a_b.translation()).norm(), 0.05);
+
+  // The true match's own grey levels agree.
+  r = SubmapMatcher().Match(*features_a_, *features_b_);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_GT(r.photometric.ncc, 0.9);
+  EXPECT_GT(r.photometric.pairs, 1000u);
 }
 
 TEST_F(SubmapMatcherTest, GateNamesTheAxisThatIsOff) {

@@ -1,0 +1,47 @@
+#pragma once
+// Whether two submaps' grey levels agree under a candidate alignment: the normalized
+// cross-correlation of the grey level of each of B's points, moved by T_a_b, with that of A's
+// points in the same voxel. On smooth ground, geometry alone cannot tell a true alignment from
+// one that slides along a ridge or turns about a crater's rim (their keypoints and ICP residuals
+// look alike); the ground's albedo pattern can. The correlation ignores the gain and offset by
+// which two cameras or exposures differ.
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "mapping/matching/four_dof_transform.h"
+
+namespace cairn {
+
+struct PhotometricScore {
+  size_t pairs = 0;  // B's points that fell into a voxel of A's
+  // NCC over those pairs, in [-1, 1]; NaN with fewer than 2 pairs or without texture on one side.
+  double ncc = std::numeric_limits<double>::quiet_NaN();
+};
+
+class PhotometricAgreement {
+ public:
+  // A's cloud and each point's grey level (same length; the shorter decides), hashed at `voxel` m.
+  PhotometricAgreement(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey, double voxel);
+
+  // B's cloud and grey levels under T_a_b; every `stride`-th point of B (>= 1).
+  PhotometricScore Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
+                         const FourDofTransform& T_a_b, size_t stride = 1) const;
+
+ private:
+  uint64_t Key(const Eigen::Vector3d& p) const;
+
+  double inverse_voxel_ = 20.0;
+  struct Cell {
+    float sum = 0.0f;
+    uint32_t count = 0;
+  };
+  std::unordered_map<uint64_t, Cell> cells_;
+};
+
+}  // namespace cairn

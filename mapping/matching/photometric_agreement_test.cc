@@ -1,0 +1,99 @@
+#include "mapping/matching/photometric_agreement.h"
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace cairn {
+namespace {
+
+// Gently rolling ground, one point per 5 cm cell over 4 x 4 m, with a random albedo pattern of
+// 20 cm patches (as the simulated ground's), in A's frame.
+struct Ground {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<float> grey;
+};
+
+Ground MakeGround(uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> level(40.0f, 200.0f);
+  std::vector<float> patch(20 * 20);
+  for (float& p : patch) p = level(rng);
+  Ground g;
+  for (int i = 0; i < 80; ++i) {
+    for (int j = 0; j < 80; ++j) {
+      const double x = 0.05 * i + 0.025, y = 0.05 * j + 0.025;
+      g.points.emplace_back(x, y, 0.1 * std::sin(x) * std::cos(0.7 * y) + 0.025);
+      g.grey.push_back(patch[static_cast<size_t>((i / 4) * 20 + j / 4)]);
+    }
+  }
+  return g;
+}
+
+// The same ground seen from B: its points in B's frame, T_a_b the truth.
+Ground InFrameB(const Ground& a, const FourDofTransform& T_a_b) {
+  Ground b = a;
+  const Eigen::Isometry3d T_b_a = T_a_b.ToIsometry().inverse();
+  for (Eigen::Vector3d& p : b.points) p = T_b_a * p;
+  return b;
+}
+
+TEST(PhotometricAgreementTest, GreyLevelsAgreeAtTheTrueAlignmentOnly) {
+  const Ground a = MakeGround(1);
+  const FourDofTransform truth(1.2, -0.4, 0.05, 0.6);
+  const Ground b = InFrameB(a, truth);
+  const PhotometricAgreement check(a.points, a.grey, 0.05);
+
+  const PhotometricScore right = check.Score(b.points, b.grey, truth);
+  EXPECT_GT(right.pairs, a.points.size() * 9 / 10);
+  EXPECT_GT(right.ncc, 0.95);
+  // Shifted by two patches, or turned by 20 degrees about a point of the ground: the geometry
+  // still lies on the ground, the pattern does not.
+  const PhotometricScore shifted = check.Score(b.points, b.grey, truth * FourDofTransform(0.4, 0.0, 0.0, 0.0));
+  const PhotometricScore turned = check.Score(b.points, b.grey, FourDofTransform(2.0, 2.0, 0.0, 0.35) *
+                                                                    FourDofTransform(-2.0, -2.0, 0.0, 0.0) * truth);
+  for (const PhotometricScore& s : {shifted, turned}) {
+    EXPECT_GT(s.pairs, 500u);
+    EXPECT_LT(std::abs(s.ncc), 0.3) << s.pairs;
+  }
+}
+
+TEST(PhotometricAgreementTest, AnotherCamerasGainAndOffsetDoNotMatter) {
+  const Ground a = MakeGround(2);
+  const FourDofTransform truth(-0.3, 0.8, 0.0, -1.1);
+  Ground b = InFrameB(a, truth);
+  for (float& g : b.grey) g = 0.6f * g + 35.0f;
+  const PhotometricScore s = PhotometricAgreement(a.points, a.grey, 0.05).Score(b.points, b.grey, truth);
+  EXPECT_GT(s.ncc, 0.95);
+  // Inverted grey levels correlate negatively: the check's threshold refuses them.
+  for (float& g : b.grey) g = 255.0f - g;
+  EXPECT_LT(PhotometricAgreement(a.points, a.grey, 0.05).Score(b.points, b.grey, truth).ncc, -0.95);
+}
+
+TEST(PhotometricAgreementTest, NoTextureNoOverlapAndBadPointsGiveNoCorrelation) {
+  Ground a = MakeGround(3);
+  const FourDofTransform truth(0.5, 0.5, 0.0, 0.2);
+  Ground b = InFrameB(a, truth);
+  // Uniform grey on one side: nothing to correlate.
+  std::vector<float> flat(b.grey.size(), 120.0f);
+  PhotometricScore s = PhotometricAgreement(a.points, a.grey, 0.05).Score(b.points, flat, truth);
+  EXPECT_GT(s.pairs, 1000u);
+  EXPECT_TRUE(std::isnan(s.ncc));
+  // Far apart: no pair.
+  s = PhotometricAgreement(a.points, a.grey, 0.05).Score(b.points, b.grey, FourDofTransform(50.0, 0.0, 0.0, 0.0));
+  EXPECT_EQ(s.pairs, 0u);
+  EXPECT_TRUE(std::isnan(s.ncc));
+  // Empty clouds, and NaN points or grey levels, are skipped; lengths that differ use the shorter.
+  EXPECT_EQ(PhotometricAgreement({}, {}, 0.05).Score(b.points, b.grey, truth).pairs, 0u);
+  a.points[0] = Eigen::Vector3d::Constant(std::nan(""));
+  b.grey[1] = std::nanf("");
+  b.grey.pop_back();
+  s = PhotometricAgreement(a.points, a.grey, 0.05).Score(b.points, b.grey, truth);
+  EXPECT_GT(s.ncc, 0.95);
+  EXPECT_LT(s.pairs, b.points.size() - 1);
+}
+
+}  // namespace
+}  // namespace cairn
