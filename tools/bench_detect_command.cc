@@ -32,7 +32,11 @@ void Print(const Series& s, size_t frames) {
 
 }  // namespace
 
+constexpr const char* kBenchDetectUsage =
+    "usage: cairn bench detect [--frames N (16)]\n";
+
 int RunBenchDetect(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchDetectUsage);
   int frames = 16;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
@@ -42,7 +46,7 @@ int RunBenchDetect(const CommandArgs& args) {
       frames = static_cast<int>(n[0]);
       ++i;
     } else {
-      std::fprintf(stderr, "usage: cairn bench detect [--frames N (16)]\n");
+      std::fputs(kBenchDetectUsage, stderr);
       return 2;
     }
   }

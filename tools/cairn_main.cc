@@ -6,12 +6,25 @@
 #include <cstdlib>
 #include <cstdio>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tools/cairn_command.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
+
+bool WantsHelp(const CommandArgs& args) {
+  for (const char* a : args.args) {
+    if (std::string_view(a) == "-h" || std::string_view(a) == "--help") return true;
+  }
+  return false;
+}
+
+int PrintUsage(const char* usage) {
+  std::fputs(usage, stdout);
+  return 0;
+}
 
 bool ParseNumberList(const std::string& s, std::vector<double>* out) {
   out->clear();

@@ -14,6 +14,11 @@ double ThreadCpuMs();
 double ProcessCpuMs();
 // Comma-separated finite numbers (at least one) into `out`; false on anything else.
 bool ParseNumberList(const std::string& s, std::vector<double>* out);
+// -h or --help anywhere among a command's arguments: it prints its usage (PrintUsage) whatever
+// else was given, rather than taking the word for a file or an unknown option.
+bool WantsHelp(const CommandArgs& args);
+// `usage` on standard output; returns 0, the command's exit status.
+int PrintUsage(const char* usage);
 
 int RunConfigCheck(const CommandArgs& args);
 int RunConfigDoc(const CommandArgs& args);

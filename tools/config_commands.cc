@@ -10,7 +10,11 @@
 
 namespace cairn::tools {
 
+constexpr const char* kConfigCheckUsage =
+    "usage: cairn config check FILE [--set key.path=value ...]\n";
+
 int RunConfigCheck(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kConfigCheckUsage);
   std::string file;
   std::vector<std::string> overrides;
   for (size_t i = 0; i < args.args.size(); ++i) {
@@ -20,12 +24,12 @@ int RunConfigCheck(const CommandArgs& args) {
     } else if (file.empty() && a.rfind("--", 0) != 0) {
       file = a;
     } else {
-      std::fprintf(stderr, "usage: cairn config check FILE [--set key.path=value ...]\n");
+      std::fputs(kConfigCheckUsage, stderr);
       return 2;
     }
   }
   if (file.empty()) {
-    std::fprintf(stderr, "usage: cairn config check FILE [--set key.path=value ...]\n");
+    std::fputs(kConfigCheckUsage, stderr);
     return 2;
   }
   auto options = LoadCairndOptions(file, overrides);

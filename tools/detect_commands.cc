@@ -46,6 +46,7 @@ Image GrayView(const cv::Mat& m) { return Image::GrayView(m.data, m.cols, m.rows
 }  // namespace
 
 int RunDetect(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kDetectUsage);
   std::string image_path, camera_path;
   std::vector<double> intrinsics;
   TagDetectorOptions detector_options;
@@ -55,10 +56,7 @@ int RunDetect(const CommandArgs& args) {
     const std::string a = args.args[i];
     const bool has_value = i + 1 < args.args.size();
     std::vector<double> v;
-    if (a == "-h" || a == "--help") {
-      std::fputs(kDetectUsage, stdout);
-      return 0;
-    } else if (a == "--camera" && has_value) {
+    if (a == "--camera" && has_value) {
       camera_path = args.args[++i];
     } else if (a == "--intrinsics" && has_value) {
       if (!ParseNumberList(args.args[++i], &intrinsics) || (intrinsics.size() != 4 && intrinsics.size() != 8) ||

@@ -178,6 +178,7 @@ TagDetectorOptions DaemonDetector(double decimate) {
 }  // namespace
 
 int RunDetectBuildLut(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBuildUsage);
   std::string camera_name, out;
   std::vector<double> intrinsics;
   double tag_size = 0.16, samples = 16, seed = 1, decimate = 2.0;
@@ -187,10 +188,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
     const std::string a = args.args[i];
     const bool has = i + 1 < args.args.size();
     bool ok = true;
-    if (a == "-h" || a == "--help") {
-      std::fputs(kBuildUsage, stdout);
-      return 0;
-    } else if (a == "--camera" && has) {
+    if (a == "--camera" && has) {
       camera_name = args.args[++i];
     } else if (a == "--out" && has) {
       out = args.args[++i];
@@ -274,16 +272,14 @@ int RunDetectBuildLut(const CommandArgs& args) {
 }
 
 int RunDetectCheckLut(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kCheckUsage);
   std::string path;
   double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 2.0, max_residual_chi2 = 13.8;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has = i + 1 < args.args.size();
     bool ok = true;
-    if (a == "-h" || a == "--help") {
-      std::fputs(kCheckUsage, stdout);
-      return 0;
-    } else if (a == "--samples" && has) {
+    if (a == "--samples" && has) {
       ok = ParseCount(args.args[++i], 1, 1e6, &samples);
     } else if (a == "--seed" && has) {
       ok = ParseCount(args.args[++i], 0, 1e15, &seed);

@@ -80,7 +80,12 @@ StallStats MeasureStalls(double seconds) {
 
 }  // namespace
 
+constexpr const char* kBenchFilterUsage =
+    "usage: cairn bench filter [--samples N] [--delay S] [--switch-period S] [--wheel-rate HZ] "
+    "[--nonholonomic] [--no-realtime]\n";
+
 int RunBenchFilter(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchFilterUsage);
   long samples = 120000;
   double delay = 0.25, switch_period = 10.0, wheel_rate = 20.0;
   bool nonholonomic = false, realtime = true;
@@ -100,9 +105,7 @@ int RunBenchFilter(const CommandArgs& args) {
     } else if (a == "--no-realtime") {
       realtime = false;
     } else {
-      std::fprintf(stderr,
-                   "usage: cairn bench filter [--samples N] [--delay S] [--switch-period S] [--wheel-rate HZ] "
-                   "[--nonholonomic] [--no-realtime]\n");
+      std::fputs(kBenchFilterUsage, stderr);
       return 2;
     }
   }

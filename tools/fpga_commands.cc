@@ -18,7 +18,11 @@
 
 namespace cairn::tools {
 
+constexpr const char* kBenchFpgaUsage =
+    "usage: cairn bench fpga [--left L --right R] [--size 1024x508] [--max-disparity 128] [--fps 30]\n";
+
 int RunBenchFpga(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchFpgaUsage);
   std::string left_path, right_path, size = "1024x508";
   int disparities = 128;
   double fps = 30.0;
@@ -36,9 +40,7 @@ int RunBenchFpga(const CommandArgs& args) {
     }
   }
   if (args.args.size() % 2 != 0) {
-    std::fprintf(stderr,
-                 "usage: cairn bench fpga [--left L --right R] [--size 1024x508] "
-                 "[--max-disparity 128] [--fps 30]\n");
+    std::fputs(kBenchFpgaUsage, stderr);
     return 2;
   }
   const char* env = std::getenv("CAIRN_DATA_DIR");

@@ -122,6 +122,7 @@ double AbsoluteTrajectoryError(const PoseGraph& g, const PoseGraph& ref) {
 }  // namespace
 
 int RunGraphSolve(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kSolveUsage);
   std::string in, out, reference;
   long long injected_after = -1;
   PoseGraphSolverOptions options;
@@ -220,7 +221,11 @@ double Percentile(std::vector<double> v, double p) {
 
 }  // namespace
 
+constexpr const char* kReplayUsage =
+    "usage: cairn graph replay IN.g2o|DIR [--loss none|cauchy:C] [--iterations N] [--reinitialize-cost C] [--inline]\n";
+
 int RunGraphReplay(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kReplayUsage);
   std::string in;
   SlamGraphOptions options;
   options.cauchy_c = 0.0;
@@ -239,7 +244,7 @@ int RunGraphReplay(const CommandArgs& args) {
     } else if (in.empty() && a.rfind("--", 0) != 0) {
       in = a;
     } else {
-      std::fputs("usage: cairn graph replay IN.g2o|DIR [--loss none|cauchy:C] [--iterations N] [--reinitialize-cost C] [--inline]\n", stderr);
+      std::fputs(kReplayUsage, stderr);
       return 2;
     }
   }
@@ -283,7 +288,11 @@ namespace cairn::tools {
 // planar graphs) and a translation uniform in [-s, s]^3 (z = 0 when planar), s = half the extent of
 // the vertex estimates, and its information is that of a uniformly drawn existing loop closure (of
 // an odometry edge when there is none). std::mt19937_64 seeded with N.
+constexpr const char* kInjectUsage =
+    "usage: cairn graph inject IN.g2o --fraction F --seed N --out OUT.g2o\n";
+
 int RunGraphInject(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kInjectUsage);
   std::string in, out;
   double fraction = -1.0;
   uint64_t seed = 0;
@@ -304,7 +313,7 @@ int RunGraphInject(const CommandArgs& args) {
     }
   }
   if (in.empty() || out.empty() || !(fraction >= 0.0 && fraction <= 10.0)) {
-    std::fputs("usage: cairn graph inject IN.g2o --fraction F --seed N --out OUT.g2o\n", stderr);
+    std::fputs(kInjectUsage, stderr);
     return 2;
   }
   auto graph = ReadG2o(in);
@@ -367,7 +376,11 @@ namespace cairn::tools {
 // with `submaps` submap origins in total, chained by frame switches, plus random noisy submap
 // matches until `factors` factors; fed interleaved as they would arrive, one Update() per factor.
 // Then the marginal covariances of all submap origins. Repeated with different seeds; medians.
+constexpr const char* kBenchGraphUsage =
+    "usage: cairn bench graph [--robots R] [--submaps S] [--factors F] [--repeats N] [--inline]\n";
+
 int RunBenchGraph(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchGraphUsage);
   int robots = 3, submaps = 200, factors = 300, repeats = 5;
   bool background = true;
   for (size_t i = 0; i < args.args.size(); i += 2) {
@@ -383,7 +396,7 @@ int RunBenchGraph(const CommandArgs& args) {
     else if (a == "--factors") factors = std::max(v, submaps);
     else if (a == "--repeats") repeats = std::max(v, 1);
     else {
-      std::fputs("usage: cairn bench graph [--robots R] [--submaps S] [--factors F] [--repeats N] [--inline]\n", stderr);
+      std::fputs(kBenchGraphUsage, stderr);
       return 2;
     }
   }

@@ -27,6 +27,7 @@ bool ValidName(const std::string& name) {
 }  // namespace
 
 int RunKeysGenerate(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kUsage);
   std::string name, dir = ".";
   bool force = false;
   for (size_t i = 0; i < args.args.size(); ++i) {

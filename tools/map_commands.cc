@@ -100,6 +100,7 @@ constexpr const char* kMapUsage =
 }  // namespace
 
 int RunMap(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kMapUsage);
   std::vector<std::string> a(args.args.begin(), args.args.end());
   if (a.empty()) {
     std::fputs(kMapUsage, stderr);
@@ -184,7 +185,11 @@ int RunMap(const CommandArgs& args) {
   return 2;
 }
 
+constexpr const char* kBenchMapUsage =
+    "usage: cairn bench map [--images N (44)] [--noise PX (0.2)] [--fusion] [--write-submap FILE]\n";
+
 int RunBenchMap(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchMapUsage);
   int images = 44;
   double noise_px = 0.2;
   std::string write_submap;
@@ -203,7 +208,7 @@ int RunBenchMap(const CommandArgs& args) {
     } else if (a == "--write-submap" && i + 1 < args.args.size()) {
       write_submap = args.args[++i];
     } else {
-      std::fprintf(stderr, "usage: cairn bench map [--images N (44)] [--noise PX (0.2)] [--fusion] [--write-submap FILE]\n");
+      std::fputs(kBenchMapUsage, stderr);
       return 2;
     }
   }

@@ -134,7 +134,16 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
 
 }  // namespace
 
+constexpr const char* kBenchMatchUsage =
+    "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
+    "                         [--no-photometric]\n"
+    "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
+    "  --wire-bits: first send every submap through the wire format at these bit counts\n"
+    "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
+    "  --no-photometric: geometry only, the keypoint spread check on every hypothesis (thesis 6.1)\n";
+
 int RunBenchMatch(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchMatchUsage);
   std::vector<std::string> dirs;
   double min_overlap = 0.3;
   std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
@@ -151,14 +160,7 @@ int RunBenchMatch(const CommandArgs& args) {
     } else if (a == "--no-photometric") {
       matcher_options.min_hypothesis_ncc = matcher_options.min_match_ncc = -1.0;
     } else if (a.empty() || a[0] == '-') {
-      std::fprintf(
-          stderr,
-          "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
-          "                         [--no-photometric]\n"
-          "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
-          "  --wire-bits: first send every submap through the wire format at these bit counts\n"
-          "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
-          "  --no-photometric: geometry only, the keypoint spread check on every hypothesis (thesis 6.1)\n");
+      std::fputs(kBenchMatchUsage, stderr);
       return 2;
     } else {
       dirs.push_back(a);
@@ -259,16 +261,14 @@ int RunBenchMatch(const CommandArgs& args) {
 }
 
 int RunMatch(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kMatchUsage);
   std::vector<std::string> files;
   std::optional<RelativePoseEstimate> prior;
   std::vector<double> guess, sigma = {1.0, 1.0, 0.5, 0.3};
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has_value = i + 1 < args.args.size();
-    if (a == "-h" || a == "--help") {
-      std::fputs(kMatchUsage, stdout);
-      return 0;
-    } else if (a == "--guess" && has_value) {
+    if (a == "--guess" && has_value) {
       if (!ParseList(args.args[++i], 4, &guess)) {
         std::fprintf(stderr, "cairn match: --guess needs four finite numbers x,y,z,yaw, got '%s'\n", args.args[i]);
         return 2;

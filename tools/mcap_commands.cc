@@ -10,9 +10,13 @@
 
 namespace cairn::tools {
 
+constexpr const char* kMcapInfoUsage =
+    "usage: cairn mcap info FILE.mcap [FILE.mcap ...]\n";
+
 int RunMcapInfo(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kMcapInfoUsage);
   if (args.args.empty()) {
-    std::fprintf(stderr, "usage: cairn mcap info FILE.mcap [FILE.mcap ...]\n");
+    std::fputs(kMcapInfoUsage, stderr);
     return 2;
   }
   int rc = 0;

@@ -127,6 +127,7 @@ bool WaitFor(ChildProcess& child, double seconds) {
 }  // namespace
 
 int RunBenchRt(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kUsage);
   BenchArgs b;
   if (!ParseArgs(args, &b)) {
     std::fprintf(stderr, "%s  --seconds >= 10 (default 600), --stress-cpus >= 0 (0: every CPU)\n", kUsage);

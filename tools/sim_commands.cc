@@ -94,6 +94,7 @@ double ThreadCpuMs() { return CpuMs(CLOCK_THREAD_CPUTIME_ID); }
 double ProcessCpuMs() { return CpuMs(CLOCK_PROCESS_CPUTIME_ID); }
 
 int RunSim(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kSimUsage);
   std::string world_path, out, rover_config;
   sim::MissionOptions mission;
   mission.robots = {"rover", "hexacopter"};
@@ -177,7 +178,11 @@ int RunSim(const CommandArgs& args) {
   return 0;
 }
 
+constexpr const char* kBenchSimUsage =
+    "usage: cairn bench sim [--repeats N]\n";
+
 int RunBenchSim(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchSimUsage);
   int repeats = 15;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
@@ -186,7 +191,7 @@ int RunBenchSim(const CommandArgs& args) {
       repeats = static_cast<int>(n);
       ++i;
     } else {
-      std::fprintf(stderr, "usage: cairn bench sim [--repeats N]\n");
+      std::fputs(kBenchSimUsage, stderr);
       return 2;
     }
   }

@@ -177,6 +177,7 @@ int RunStereo(const CommandArgs& args) {
       "[--backend simd|scalar|fpga-sim] "
       "[--census WxH] [--fill] [--matcher sgm|opencv-3way|opencv-hh4] [--p1 P] [--p2 P] "
       "[--uniqueness PERCENT] [--speckle-size PIXELS] [--bidirectional]\n";
+  if (WantsHelp(args)) return PrintUsage(usage);
   const ArgMap a(args,
                  {"--max-disparity", "--min-disparity", "--calib", "--paths", "--out", "--png",
                   "--threads", "--backend", "--census", "--matcher", "--p1", "--p2", "--uniqueness",
@@ -264,6 +265,7 @@ int RunStereoEval(const CommandArgs& args) {
   const char* usage =
       "usage: cairn stereo-eval --est DISP.pfm --gt GT [--gt-scale S] [--mask MASK] "
       "[--metric bad0.5|bad1|bad2|bad4|d1]\n";
+  if (WantsHelp(args)) return PrintUsage(usage);
   const ArgMap a(args, {"--est", "--gt", "--gt-scale", "--mask", "--metric"}, {});
   if (!a.error.empty() || !a.positional.empty() || a.Get("--est").empty() || a.Get("--gt").empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
@@ -294,7 +296,12 @@ int RunStereoEval(const CommandArgs& args) {
   return 0;
 }
 
+constexpr const char* kBenchStereoUsage =
+    "usage: cairn bench stereo [--left L --right R] [--size 1024x508] "
+    "[--max-disparity 128] [--paths 4] [--threads 2] [--iterations 15]\n";
+
 int RunBenchStereo(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchStereoUsage);
   const ArgMap a(args,
                  {"--left", "--right", "--size", "--max-disparity", "--min-disparity", "--paths",
                   "--threads", "--iterations", "--backend", "--census", "--p1", "--p2",
@@ -302,9 +309,7 @@ int RunBenchStereo(const CommandArgs& args) {
                  {});
   if (!a.error.empty() || !a.positional.empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
-    std::fprintf(stderr,
-                 "usage: cairn bench stereo [--left L --right R] [--size 1024x508] "
-                 "[--max-disparity 128] [--paths 4] [--threads 2] [--iterations 15]\n");
+    std::fputs(kBenchStereoUsage, stderr);
     return 2;
   }
   const char* env = std::getenv("CAIRN_DATA_DIR");

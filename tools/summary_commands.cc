@@ -172,9 +172,13 @@ void PrintAgreement(const std::vector<TeamView>& views) {
 
 }  // namespace
 
+constexpr const char* kSummaryUsage =
+    "usage: cairn summary OUT_DIR [OUT_DIR ...]\n";
+
 int RunSummary(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kSummaryUsage);
   if (args.args.empty()) {
-    std::fprintf(stderr, "usage: cairn summary OUT_DIR [OUT_DIR ...]\n");
+    std::fputs(kSummaryUsage, stderr);
     return 2;
   }
   int rc = 0;

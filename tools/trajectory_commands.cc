@@ -11,7 +11,11 @@
 
 namespace cairn::tools {
 
+constexpr const char* kTrajectoryConvertUsage =
+    "usage: cairn trajectory convert IN OUT [--from F] [--to F] [--times FILE]\n";
+
 int RunTrajectoryConvert(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kTrajectoryConvertUsage);
   std::string in, out, from, to, times;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
@@ -22,12 +26,12 @@ int RunTrajectoryConvert(const CommandArgs& args) {
     else if (in.empty() && a.rfind("--", 0) != 0) in = a;
     else if (out.empty() && a.rfind("--", 0) != 0) out = a;
     else {
-      std::fprintf(stderr, "usage: cairn trajectory convert IN OUT [--from F] [--to F] [--times FILE]\n");
+      std::fputs(kTrajectoryConvertUsage, stderr);
       return 2;
     }
   }
   if (in.empty() || out.empty()) {
-    std::fprintf(stderr, "usage: cairn trajectory convert IN OUT [--from F] [--to F] [--times FILE]\n");
+    std::fputs(kTrajectoryConvertUsage, stderr);
     return 2;
   }
   auto in_format = from.empty() ? TrajectoryIo::FormatFromPath(in) : TrajectoryIo::FormatFromName(from);

@@ -47,6 +47,7 @@ Expected<Trajectory> ReadAny(const std::string& path) {
 
 int RunEval(const CommandArgs& args) {
   const char* usage = "usage: cairn eval --gt GT --est EST [--align se3|4dof|none] [--segments 1,2,5] [--max-dt S]\n";
+  if (WantsHelp(args)) return PrintUsage(usage);
   std::string gt_path, est_path, align = "se3";
   TrajectoryEvalOptions o;
   for (size_t i = 0; i < args.args.size(); ++i) {
@@ -118,7 +119,11 @@ int RunEval(const CommandArgs& args) {
   return 0;
 }
 
+constexpr const char* kBenchVoUsage =
+    "usage: cairn bench vo [--data EUROC_DIR] [--repeat N]\n";
+
 int RunBenchVo(const CommandArgs& args) {
+  if (WantsHelp(args)) return PrintUsage(kBenchVoUsage);
   std::string dir = "../shared/data/euroc-v1_01-micro";
   int repeat = 3;
   for (size_t i = 0; i < args.args.size(); ++i) {
@@ -127,7 +132,7 @@ int RunBenchVo(const CommandArgs& args) {
     if (a == "--data" && has_value) dir = args.args[++i];
     else if (a == "--repeat" && has_value) repeat = std::max(1, std::atoi(args.args[++i]));
     else {
-      std::fprintf(stderr, "usage: cairn bench vo [--data EUROC_DIR] [--repeat N]\n");
+      std::fputs(kBenchVoUsage, stderr);
       return 2;
     }
   }
