@@ -7,35 +7,30 @@ namespace cairn {
 
 PhotometricAgreement::PhotometricAgreement(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
                                            double voxel)
-    : inverse_voxel_(1.0 / voxel) {
+    : inverse_voxel_(static_cast<float>(1.0 / voxel)), cells_(std::min(cloud.size(), grey.size())) {
   const size_t n = std::min(cloud.size(), grey.size());
-  cells_.reserve(n);
   for (size_t i = 0; i < n; ++i) {
-    if (!cloud[i].allFinite() || !std::isfinite(grey[i])) continue;
-    Cell& c = cells_[Key(cloud[i])];
+    uint64_t key = 0;
+    if (!std::isfinite(grey[i]) || !VoxelKey::Of(cloud[i].cast<float>(), inverse_voxel_, &key)) continue;
+    Cell& c = cells_[key];
     c.sum += grey[i];
     ++c.count;
   }
 }
 
-uint64_t PhotometricAgreement::Key(const Eigen::Vector3d& p) const {
-  // 21 bits per axis: unique within +-52 km at 5 cm, far beyond a submap.
-  const auto axis = [&](double v) { return static_cast<uint64_t>(static_cast<int64_t>(std::floor(v * inverse_voxel_))) & 0x1fffff; };
-  return axis(p.x()) | axis(p.y()) << 21 | axis(p.z()) << 42;
-}
-
 PhotometricScore PhotometricAgreement::Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
-                                             const FourDofTransform& T_a_b, size_t stride) const {
+                                             const FourDofTransform& T_a_b) const {
   PhotometricScore out;
   const Eigen::Isometry3d T = T_a_b.ToIsometry();
   const size_t n = std::min(cloud.size(), grey.size());
   // Sums about the first pair's values, so that the variances do not cancel catastrophically.
   double a0 = 0.0, b0 = 0.0, sa = 0.0, sb = 0.0, saa = 0.0, sbb = 0.0, sab = 0.0;
-  for (size_t i = 0; i < n; i += std::max<size_t>(stride, 1)) {
-    if (!cloud[i].allFinite() || !std::isfinite(grey[i])) continue;
-    const auto it = cells_.find(Key(T * cloud[i]));
-    if (it == cells_.end()) continue;
-    double a = it->second.sum / static_cast<double>(it->second.count), b = grey[i];
+  for (size_t i = 0; i < n; ++i) {
+    uint64_t key = 0;
+    if (!std::isfinite(grey[i]) || !VoxelKey::Of((T * cloud[i]).cast<float>(), inverse_voxel_, &key)) continue;
+    const Cell* cell = cells_.Find(key);
+    if (cell == nullptr) continue;
+    double a = cell->sum / static_cast<double>(cell->count), b = grey[i];
     if (out.pairs == 0) {
       a0 = a;
       b0 = b;

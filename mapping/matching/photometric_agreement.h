@@ -9,12 +9,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "mapping/matching/four_dof_transform.h"
+#include "mapping/voxel_hash_map.h"
 
 namespace cairn {
 
@@ -29,19 +29,17 @@ class PhotometricAgreement {
   // A's cloud and each point's grey level (same length; the shorter decides), hashed at `voxel` m.
   PhotometricAgreement(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey, double voxel);
 
-  // B's cloud and grey levels under T_a_b; every `stride`-th point of B (>= 1).
+  // B's cloud and grey levels under T_a_b.
   PhotometricScore Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
-                         const FourDofTransform& T_a_b, size_t stride = 1) const;
+                         const FourDofTransform& T_a_b) const;
 
  private:
-  uint64_t Key(const Eigen::Vector3d& p) const;
-
-  double inverse_voxel_ = 20.0;
+  float inverse_voxel_ = 20.0f;
   struct Cell {
     float sum = 0.0f;
     uint32_t count = 0;
   };
-  std::unordered_map<uint64_t, Cell> cells_;
+  VoxelHashMap<Cell> cells_;
 };
 
 }  // namespace cairn

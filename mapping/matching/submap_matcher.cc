@@ -171,8 +171,8 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     return JudgeGrey(last_grey, min_ncc, options_.min_photometric_pairs, why);
   };
   const auto SpreadOk = [&](const Hypothesis& h, std::string* why) {
+    if (options_.min_off_line_inliers <= 0) return true;
     for (const auto* side : {&a, &b}) {
-      if (options_.min_off_line_inliers <= 0) break;
       const std::vector<uint32_t>& ids = side == &a ? h.a_keypoints : h.b_keypoints;
       inlier_points.clear();
       for (const uint32_t id : ids) inlier_points.push_back(side->described.points[id]);

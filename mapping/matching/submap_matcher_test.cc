@@ -1,12 +1,12 @@
 #include "mapping/matching/submap_matcher.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <numbers>
 #include <random>
-#include <algorithm>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
