@@ -98,9 +98,23 @@ TEST_F(CairnMatchTest, AnEmptySubmapIsUnsuitableWithTheReason) {
 TEST_F(CairnMatchTest, BadOptionsAreRefusedWithUsage) {
   EXPECT_EQ(Match({dir_ + "/a.submap", dir_ + "/b.submap", "--guess", "1,2,nan,0"}).exit_code, 2);
   EXPECT_EQ(Match({dir_ + "/a.submap", dir_ + "/b.submap", "--sigma", "1,1,0,1"}).exit_code, 2);
-  const auto r = Match({dir_ + "/a.submap", dir_ + "/b.submap", "--dof", "6"});
+  const auto r = Match({dir_ + "/a.submap", dir_ + "/b.submap", "--dof", "5"});
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("only the 4-DoF matcher is built"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--dof 5: 4 or 6"), std::string::npos) << r.output;
+}
+
+TEST_F(CairnMatchTest, TheSixDofVariantPrintsTheFullTransform) {
+  const auto r = Match({dir_ + "/a.submap", dir_ + "/b.submap", "--dof", "6"});
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const JsonValue j = JsonValue::Parse(r.output);
+  ASSERT_EQ(j["status"].string(), "matched") << r.output;
+  EXPECT_EQ(j["dof"].number(), 6);
+  const JsonValue& t = j["T_a_b"];
+  EXPECT_NEAR(t["x"].number(), T_a_b_.translation().x(), 0.05);
+  EXPECT_NEAR(t["yaw"].number(), std::atan2(T_a_b_.linear()(1, 0), T_a_b_.linear()(0, 0)), 0.01);
+  EXPECT_LT(t["tilt"].number(), 0.01);
+  // The matrix holds the estimated roll and pitch: its z column is within the tilt of z.
+  EXPECT_NEAR(t["matrix"][size_t{2}][size_t{2}].number(), std::cos(t["tilt"].number()), 1e-9);
 }
 
 }  // namespace

@@ -25,23 +25,25 @@ namespace cairn::tools {
 namespace {
 
 constexpr const char* kMatchUsage =
-    "usage: cairn match A.submap B.submap [--guess x,y,z,yaw] [--sigma sx,sy,sz,syaw] [--dof 4]\n"
+    "usage: cairn match A.submap B.submap [--guess x,y,z,yaw] [--sigma sx,sy,sz,syaw] [--dof 4|6]\n"
     "  Matches submap B against submap A and prints T_a_b (B's origin in A's frame) as JSON.\n"
     "  --guess   what is known of T_a_b (m, m, m, rad); the hypotheses and the result must lie within\n"
     "            2 sigma of it. Without it the search is global.\n"
     "  --sigma   standard deviations of the guess (default 1,1,0.5,0.3)\n"
-    "  --dof     4 (gravity-aligned submaps; the only variant built so far)\n";
+    "  --dof     4: gravity-aligned submaps (default); 6: the variant that does not use gravity\n";
 
 // Comma-separated finite numbers, exactly `count` of them.
 bool ParseList(const std::string& s, size_t count, std::vector<double>* out) {
   return ParseNumberList(s, out) && out->size() == count;
 }
 
-void WriteTransform(JsonWriter& j, const FourDofTransform& T) {
+// x, y, z, yaw and the full matrix (in 6-DoF with its roll and pitch; `tilt` says how much).
+void WriteTransform(JsonWriter& j, const SubmapMatchResult& result) {
+  const FourDofTransform& T = result.T_a_b;
   j.Key("T_a_b").BeginObject();
-  j.Field("x", T.x()).Field("y", T.y()).Field("z", T.z()).Field("yaw", T.yaw());
+  j.Field("x", T.x()).Field("y", T.y()).Field("z", T.z()).Field("yaw", T.yaw()).Field("tilt", result.tilt);
   j.Key("matrix").BeginArray();
-  const Eigen::Matrix4d m = T.ToIsometry().matrix();
+  const Eigen::Matrix4d m = result.T_a_b_full.matrix();
   for (int r = 0; r < 4; ++r) {
     j.BeginArray();
     for (int c = 0; c < 4; ++c) j.Number(m(r, c));
@@ -136,11 +138,12 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
 
 constexpr const char* kBenchMatchUsage =
     "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
-    "                         [--no-photometric]\n"
+    "                         [--no-photometric] [--dof 4|6]\n"
     "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
     "  --wire-bits: first send every submap through the wire format at these bit counts\n"
     "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
-    "  --no-photometric: geometry only, the keypoint spread check on every hypothesis (thesis 6.1)\n";
+    "  --no-photometric: geometry only, the keypoint spread check on every hypothesis (thesis 6.1)\n"
+    "  --dof 6: the matcher's variant without gravity; a match must then also be level within 0.5 deg\n";
 
 int RunBenchMatch(const CommandArgs& args) {
   if (WantsHelp(args)) return PrintUsage(kBenchMatchUsage);
@@ -148,6 +151,7 @@ int RunBenchMatch(const CommandArgs& args) {
   double min_overlap = 0.3;
   std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
   SubmapMatcherOptions matcher_options;
+  ShotFrame frame = ShotFrame::kGravity;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     std::vector<double> v;
@@ -159,6 +163,9 @@ int RunBenchMatch(const CommandArgs& args) {
       ++i;
     } else if (a == "--no-photometric") {
       matcher_options.min_hypothesis_ncc = matcher_options.min_match_ncc = -1.0;
+    } else if (a == "--dof" && i + 1 < args.args.size() &&
+               (args.args[i + 1] == std::string("4") || args.args[i + 1] == std::string("6"))) {
+      frame = args.args[++i] == std::string("6") ? ShotFrame::kFull : ShotFrame::kGravity;
     } else if (a.empty() || a[0] == '-') {
       std::fputs(kBenchMatchUsage, stderr);
       return 2;
@@ -194,7 +201,7 @@ int RunBenchMatch(const CommandArgs& args) {
       s.submap = *back;
     }
   }
-  const SubmapFeatureExtractor extractor;
+  const SubmapFeatureExtractor extractor({}, frame);
   std::vector<double> feature_ms;
   size_t suitable = 0;
   for (IndexedSubmap& s : submaps) {
@@ -221,7 +228,8 @@ int RunBenchMatch(const CommandArgs& args) {
       const SubmapMatchResult r = matcher.Match(a.features, b.features);
       match_ms.push_back(r.times.total_ms);
       const FourDofTransform error = truth.inverse() * r.T_a_b;
-      const bool good = r.matched() && error.translation().norm() <= 0.05 && std::abs(error.yaw()) <= 0.5 * M_PI / 180;
+      const bool good = r.matched() && error.translation().norm() <= 0.05 && std::abs(error.yaw()) <= 0.5 * M_PI / 180 &&
+                        r.tilt <= 0.5 * M_PI / 180;
       matched += r.matched();
       correct += good;
       if (good) {
@@ -241,6 +249,7 @@ int RunBenchMatch(const CommandArgs& args) {
       if (r.matched()) {
         std::printf(" error %.3f m %.2f deg, grey levels %.3f", error.translation().norm(),
                     std::abs(error.yaw()) * 180 / M_PI, r.photometric.ncc);
+        if (r.dof == 6) std::printf(", tilt %.2f deg", r.tilt * 180 / M_PI);
       } else {
         std::printf(" (%s)", r.reason.c_str());
       }
@@ -265,6 +274,7 @@ int RunMatch(const CommandArgs& args) {
   std::vector<std::string> files;
   std::optional<RelativePoseEstimate> prior;
   std::vector<double> guess, sigma = {1.0, 1.0, 0.5, 0.3};
+  ShotFrame frame = ShotFrame::kGravity;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has_value = i + 1 < args.args.size();
@@ -282,10 +292,11 @@ int RunMatch(const CommandArgs& args) {
       }
     } else if (a == "--dof" && has_value) {
       const std::string dof = args.args[++i];
-      if (dof != "4") {
-        std::fprintf(stderr, "cairn match: --dof %s: only the 4-DoF matcher is built\n", dof.c_str());
+      if (dof != "4" && dof != "6") {
+        std::fprintf(stderr, "cairn match: --dof %s: 4 or 6\n", dof.c_str());
         return 2;
       }
+      frame = dof == "6" ? ShotFrame::kFull : ShotFrame::kGravity;
     } else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "cairn match: unknown or incomplete option '%s'\n%s", a.c_str(), kMatchUsage);
       return 2;
@@ -312,7 +323,7 @@ int RunMatch(const CommandArgs& args) {
       return 1;
     }
   }
-  const SubmapFeatureExtractor extractor;
+  const SubmapFeatureExtractor extractor({}, frame);
   const SubmapFeatures fa = extractor.Extract(**a), fb = extractor.Extract(**b);
   const SubmapMatchResult r = SubmapMatcher().Match(fa, fb, prior);
 
@@ -320,11 +331,11 @@ int RunMatch(const CommandArgs& args) {
   j.BeginObject();
   j.Field("status", MatchStatusName(r.status));
   j.Field("reason", r.reason);
-  j.Field("dof", 4);
+  j.Field("dof", r.dof);
   WriteFeatures(j, "a", files[0], fa);
   WriteFeatures(j, "b", files[1], fb);
   if (r.matched()) {
-    WriteTransform(j, r.T_a_b);
+    WriteTransform(j, r);
     j.Key("covariance_order").BeginArray().String("x").String("y").String("z").String("yaw").EndArray();
     j.Key("covariance").BeginArray();
     for (int row = 0; row < 4; ++row) {

@@ -16,6 +16,10 @@ struct SubmapMatchingOptions {
   bool enabled = false;
   int64_t workers = 1;  // matcher pool threads (executors.matcher schedules them)
   int64_t queue = 4;    // jobs handed to the pool and not yet finished
+  // 4: the thesis' matcher on gravity-aligned submaps; 6: its variant without gravity, which finds
+  // fewer matches (submap_matcher.h) and exists to measure that. Either way the graph takes the
+  // match's x, y, z and yaw.
+  ShotFrame dof = ShotFrame::kGravity;
   // Roll and pitch between two gravity-aligned origins, which a 4-DoF match does not measure.
   double tilt_sigma = 0.01;  // rad
   bool write_csv = true;            // OUT/matches.csv
@@ -27,6 +31,7 @@ struct SubmapMatchingOptions {
     v.Flag("enabled", enabled);
     v.Integer("workers", workers, 1, 64, "threads");
     v.Integer("queue", queue, 1, 1024, "jobs");
+    v.Choice("dof", dof, {{"4", ShotFrame::kGravity}, {"6", ShotFrame::kFull}});
     v.Number("tilt_sigma", tilt_sigma, 1e-6, 1.0, "rad");
     v.Flag("write_csv", write_csv);
     v.Section("features", features);

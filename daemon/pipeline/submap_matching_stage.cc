@@ -28,7 +28,7 @@ SubmapMatchingStage::SubmapMatchingStage(const SubmapMatchingOptions& options, s
       robot_(std::move(robot)),
       deterministic_(deterministic),
       notify_(std::move(notify)),
-      extractor_(options.features),
+      extractor_(options.features, options.dof),
       matcher_(options.matcher),
       pairing_(options.pairing) {
   if (!deterministic_) {

@@ -16,7 +16,10 @@ using testing::LoopMission;
 using testing::MakeLoop;
 using testing::OriginError;
 
-TEST(SubmapMatchingStageTest, ClosesTheLoopAndTheGraphMovesToTheTruth) {
+class SubmapMatchingStageTest : public ::testing::TestWithParam<ShotFrame> {};
+
+// Both variants close the loop; the 6-DoF one (matching.dof: 6) without gravity.
+TEST_P(SubmapMatchingStageTest, ClosesTheLoopAndTheGraphMovesToTheTruth) {
   const LoopMission m = MakeLoop(6);
   GraphStageOptions go;
   go.enabled = true;
@@ -25,6 +28,7 @@ TEST(SubmapMatchingStageTest, ClosesTheLoopAndTheGraphMovesToTheTruth) {
   GraphStage odometry_only(go, /*deterministic=*/true);
   SubmapMatchingOptions mo;
   mo.enabled = true;
+  mo.dof = GetParam();
   SubmapMatchingStage stage(mo, "rover", /*deterministic=*/true, ExecutorOptions{}, nullptr);
   stage.Start();
   for (const GraphInput& in : m.inputs) {
@@ -58,6 +62,7 @@ TEST(SubmapMatchingStageTest, ClosesTheLoopAndTheGraphMovesToTheTruth) {
   for (const MatchAttempt& a : stage.attempts()) {
     EXPECT_NE(a.a.id + 1, a.b.id) << "consecutive submaps are never paired";
     if (!a.result.matched()) continue;
+    EXPECT_EQ(a.result.dof, GetParam() == ShotFrame::kFull ? 6 : 4);
     const Eigen::Isometry3d truth = m.T_world_origin[a.a.id].inverse() * m.T_world_origin[a.b.id];
     EXPECT_LT((a.result.T_a_b.translation() - truth.translation()).norm(), 0.05) << a.a.id << "-" << a.b.id;
   }
@@ -80,6 +85,11 @@ TEST(SubmapMatchingStageTest, ClosesTheLoopAndTheGraphMovesToTheTruth) {
   EXPECT_EQ(rows, stage.attempts().size());
   EXPECT_EQ(graph.report().matches, r.accepted);
 }
+
+INSTANTIATE_TEST_SUITE_P(Variants, SubmapMatchingStageTest, ::testing::Values(ShotFrame::kGravity, ShotFrame::kFull),
+                         [](const ::testing::TestParamInfo<ShotFrame>& variant) {
+                           return std::string(variant.param == ShotFrame::kFull ? "SixDof" : "FourDof");
+                         });
 
 }  // namespace
 }  // namespace cairn

@@ -44,82 +44,22 @@
 //
 // Points with a non-finite coordinate are skipped and counted. Nothing is allocated per iteration.
 
-#include <cstddef>
-#include <cstdint>
 #include <span>
 
 #include <Eigen/Core>
 
-#include "common/options_visitor.h"
-#include "common/status.h"
 #include "mapping/matching/four_dof_transform.h"
+#include "mapping/matching/icp_options.h"
+#include "mapping/matching/point_to_plane_icp.h"
 
 namespace cairn {
 
-struct FourDofIcpOptions {
-  int64_t max_iterations = 50;
-  double max_correspondence_distance = 1.0;   // m; gate of the first iteration
-  double min_correspondence_distance = 0.15;  // m; the gate's floor
-  double gate_shrink = 0.6;                   // gate factor per iteration
-  int64_t normal_neighbours = 12;             // k of the target's local PCA
-  double normal_radius = 0.3;                 // m; farther neighbours do not count
-  int64_t min_normal_neighbours = 6;
-  double max_surface_variation = 0.05;  // lambda_0 / (lambda_0 + lambda_1 + lambda_2)
-  double min_planar_ratio = 0.05;       // lambda_1 / lambda_2
-  bool unique_targets = true;           // one source point per target point (see above)
-  int64_t min_correspondences = 100;    // fewer overlapping points is a failure
-  double min_observability = 0.001;     // see the header comment
-  double translation_tolerance = 1e-5;  // m
-  double yaw_tolerance = 1e-6;          // rad
-  double max_step_sigmas = 0.05;        // step^T Sigma^-1 step below its square
-  int64_t freeze_after = 5;             // passes at the gate's minimum before the pairs are kept
-
-  void Visit(OptionsVisitor& v) {
-    v.Integer("max_iterations", max_iterations, 1, 10'000, "");
-    v.Number("max_correspondence_distance", max_correspondence_distance, 1e-3, 100.0, "m");
-    v.Number("min_correspondence_distance", min_correspondence_distance, 1e-3, 100.0, "m");
-    v.Number("gate_shrink", gate_shrink, 0.05, 1.0, "");
-    v.Integer("normal_neighbours", normal_neighbours, 3, 256, "");
-    v.Number("normal_radius", normal_radius, 1e-3, 10.0, "m");
-    v.Integer("min_normal_neighbours", min_normal_neighbours, 3, 256, "");
-    v.Number("max_surface_variation", max_surface_variation, 0.0, 1.0 / 3.0, "");
-    v.Number("min_planar_ratio", min_planar_ratio, 0.0, 1.0, "");
-    v.Flag("unique_targets", unique_targets);
-    v.Integer("min_correspondences", min_correspondences, 5, 100'000'000, "");
-    v.Number("min_observability", min_observability, 0.0, 1.0, "");
-    v.Number("translation_tolerance", translation_tolerance, 0.0, 1.0, "m");
-    v.Number("yaw_tolerance", yaw_tolerance, 0.0, 1.0, "rad");
-    v.Number("max_step_sigmas", max_step_sigmas, 0.0, 1.0, "");
-    v.Integer("freeze_after", freeze_after, 1, 10'000, "");
-  }
-  Status Validate() const;
-};
-
-struct FourDofIcpResult {
-  // Ok when converged on well-constrained geometry. Otherwise: kInvalidArgument (options),
-  // kFailedPrecondition (too few finite points or target normals; or degenerate geometry, then
-  // `degenerate` is set), kNotFound (fewer than min_correspondences overlapping points), kTimeout
-  // (not converged within max_iterations), kInternal (a singular system).
-  Status status;
-  FourDofTransform T_a_b;  // the last estimate (the initial one when no step was made)
-  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();  // (x, y, z, yaw); set when status is ok
-  bool converged = false;
-  bool degenerate = false;
-  int64_t iterations = 0;  // Gauss-Newton steps
-  size_t inliers = 0;      // correspondences of the final pass
-  double rms = 0.0;        // m; RMS point-to-plane residual of the final pass
-  double overlap = 0.0;    // inliers / finite source points
-  double observability = 0.0;
-  size_t skipped_source = 0;  // non-finite points
-  size_t skipped_target = 0;
-  size_t target_normals = 0;  // target points with a good normal
-
-  bool ok() const { return status.ok(); }
-};
+// Covariance (x, y, z, yaw), as above.
+using FourDofIcpResult = IcpOutcome<FourDofTransform, 4>;
 
 class FourDofIcp {
  public:
-  explicit FourDofIcp(const FourDofIcpOptions& options = {}) : options_(options) {}
+  explicit FourDofIcp(const IcpOptions& options = {}) : options_(options) {}
 
   // Aligns `source_b` (submap B's cloud, B's frame) to `target_a` (submap A's cloud, A's frame)
   // starting from `T_a_b_initial`.
@@ -127,7 +67,7 @@ class FourDofIcp {
                          const FourDofTransform& T_a_b_initial) const;
 
  private:
-  FourDofIcpOptions options_;
+  IcpOptions options_;
 };
 
 }  // namespace cairn

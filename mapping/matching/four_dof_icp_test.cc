@@ -14,61 +14,10 @@
 
 #include "common/angles.h"
 #include "estimation/math/ordered_draws.h"
+#include "mapping/matching/testing/icp_test_scene.h"
 
 namespace cairn {
 namespace {
-
-// Samples the parallelogram o + a u + b v at cell centres shifted by `offset` (in cells) so that
-// two clouds of one scene can hold different points.
-void SampleRect(const Eigen::Vector3d& o, const Eigen::Vector3d& u, const Eigen::Vector3d& v, double spacing,
-                double offset, std::vector<Eigen::Vector3d>* out) {
-  const int nu = std::max(1, static_cast<int>(std::lround(u.norm() / spacing)));
-  const int nv = std::max(1, static_cast<int>(std::lround(v.norm() / spacing)));
-  for (int i = 0; i < nu; ++i) {
-    for (int j = 0; j < nv; ++j) out->push_back(o + (i + offset) / nu * u + (j + offset) / nv * v);
-  }
-}
-
-// Sides and top of a box standing on z = 0.
-void SampleBox(double cx, double cy, double sx, double sy, double h, double yaw, double spacing,
-               double offset, std::vector<Eigen::Vector3d>* out) {
-  const Eigen::Vector3d ex(std::cos(yaw), std::sin(yaw), 0.0), ey(-std::sin(yaw), std::cos(yaw), 0.0);
-  const Eigen::Vector3d up(0.0, 0.0, h);
-  const Eigen::Vector3d o = Eigen::Vector3d(cx, cy, 0.0) - 0.5 * sx * ex - 0.5 * sy * ey;
-  SampleRect(o + up, sx * ex, sy * ey, spacing, offset, out);
-  SampleRect(o, sx * ex, up, spacing, offset, out);
-  SampleRect(o, sy * ey, up, spacing, offset, out);
-  SampleRect(o + sy * ey, sx * ex, up, spacing, offset, out);
-  SampleRect(o + sx * ex, sy * ey, up, spacing, offset, out);
-}
-
-// A gravity-aligned terrain in A's frame: ground, a slope, boxes at several headings and a ridge
-// of two tilted faces (a crude rock), so every one of x, y, z and yaw is constrained.
-std::vector<Eigen::Vector3d> Scene(double spacing, double offset) {
-  std::vector<Eigen::Vector3d> pts;
-  SampleRect({-3.0, -3.0, 0.0}, {6.0, 0.0, 0.0}, {0.0, 4.5, 0.0}, spacing, offset, &pts);
-  SampleRect({-3.0, 1.5, 0.0}, {6.0, 0.0, 0.0}, {0.0, 1.5, 0.6}, spacing, offset, &pts);  // 22 deg slope
-  SampleBox(-1.2, -1.0, 0.8, 0.5, 0.5, 0.3, spacing, offset, &pts);
-  SampleBox(0.8, -1.8, 0.6, 0.6, 0.8, -0.5, spacing, offset, &pts);
-  SampleBox(0.5, 0.6, 1.0, 0.4, 0.4, 1.2, spacing, offset, &pts);
-  SampleBox(1.5, -0.2, 0.5, 0.7, 0.6, 0.0, spacing, offset, &pts);
-  SampleRect({-2.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, {0.0, 0.45, 0.45}, spacing, offset, &pts);
-  SampleRect({-2.0, 0.9, 0.0}, {1.0, 0.0, 0.0}, {0.0, -0.45, 0.45}, spacing, offset, &pts);
-  return pts;
-}
-
-// Points of `scene` with x in [x_min, x_max], moved by T and given noise.
-std::vector<Eigen::Vector3d> Cloud(const std::vector<Eigen::Vector3d>& scene, double x_min, double x_max,
-                                   const FourDofTransform& T, double noise, uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> gauss(0.0, 1.0);
-  std::vector<Eigen::Vector3d> out;
-  for (const Eigen::Vector3d& p : scene) {
-    if (p.x() < x_min || p.x() > x_max) continue;
-    out.push_back(T * p + noise * DrawVector3(gauss, rng));
-  }
-  return out;
-}
 
 const FourDofTransform kTruth(1.5, -0.8, 0.2, 0.9);  // T_a_b
 
@@ -84,9 +33,9 @@ Eigen::Vector4d Error(const FourDofTransform& estimate, const FourDofTransform& 
 }
 
 TEST(FourDofIcpTest, ConvergesFromAPerturbedStartOnNoiseFreeData) {
-  const std::vector<Eigen::Vector3d> scene = Scene(0.1, 0.5);
-  const std::vector<Eigen::Vector3d> target = Cloud(scene, -10.0, 2.0, FourDofTransform(), 0.0, 1);
-  const std::vector<Eigen::Vector3d> source = Cloud(scene, -2.0, 10.0, kTruth.inverse(), 0.0, 2);
+  const std::vector<Eigen::Vector3d> scene = IcpTestScene(0.1, 0.5);
+  const std::vector<Eigen::Vector3d> target = IcpTestCloud(scene, -10.0, 2.0, FourDofTransform(), 0.0, 1);
+  const std::vector<Eigen::Vector3d> source = IcpTestCloud(scene, -2.0, 10.0, kTruth.inverse(), 0.0, 2);
   const FourDofIcpResult r = FourDofIcp().Align(target, source, Perturbed(kTruth));
   ASSERT_TRUE(r.ok()) << r.status.ToString();
   EXPECT_TRUE(r.converged);
@@ -103,10 +52,10 @@ TEST(FourDofIcpTest, ConvergesFromAPerturbedStartOnNoiseFreeData) {
 }
 
 TEST(FourDofIcpTest, ConvergesWithCentimetreNoiseOnDifferentSamples) {
-  const std::vector<Eigen::Vector3d> scene_a = Scene(0.1, 0.5);
-  const std::vector<Eigen::Vector3d> scene_b = Scene(0.1, 0.15);  // other points of the same surfaces
-  const std::vector<Eigen::Vector3d> target = Cloud(scene_a, -10.0, 2.0, FourDofTransform(), 0.01, 3);
-  const std::vector<Eigen::Vector3d> source = Cloud(scene_b, -2.0, 10.0, kTruth.inverse(), 0.01, 4);
+  const std::vector<Eigen::Vector3d> scene_a = IcpTestScene(0.1, 0.5);
+  const std::vector<Eigen::Vector3d> scene_b = IcpTestScene(0.1, 0.15);  // other points of the same surfaces
+  const std::vector<Eigen::Vector3d> target = IcpTestCloud(scene_a, -10.0, 2.0, FourDofTransform(), 0.01, 3);
+  const std::vector<Eigen::Vector3d> source = IcpTestCloud(scene_b, -2.0, 10.0, kTruth.inverse(), 0.01, 4);
   const FourDofIcpResult r = FourDofIcp().Align(target, source, Perturbed(kTruth));
   ASSERT_TRUE(r.ok()) << r.status.ToString();
   const Eigen::Vector4d e = Error(r.T_a_b, kTruth);
@@ -128,7 +77,7 @@ TEST(FourDofIcpTest, ConvergesWithCentimetreNoiseOnDifferentSamples) {
 
 // Over repeated noisy trials the normalized estimation error squared e^T Sigma^-1 e of a
 // consistent 4-D covariance averages 4; too small a covariance gives much more, too large much less.
-double MeanNees(const FourDofIcpOptions& options, int trials, uint64_t seed) {
+double MeanNees(const IcpOptions& options, int trials, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   double sum = 0.0;
@@ -137,11 +86,11 @@ double MeanNees(const FourDofIcpOptions& options, int trials, uint64_t seed) {
     // Each trial samples the surfaces afresh: with one fixed sampling its discretization error
     // would be the same bias in every trial, which no noise covariance describes.
     const double offset_a = 0.5 + 0.5 * unit(rng);
-    const std::vector<Eigen::Vector3d> scene_a = Scene(0.1, offset_a);
+    const std::vector<Eigen::Vector3d> scene_a = IcpTestScene(0.1, offset_a);
     const double offset_b = 0.5 + 0.5 * unit(rng);
-    const std::vector<Eigen::Vector3d> scene_b = Scene(0.1, offset_b);
-    const std::vector<Eigen::Vector3d> target = Cloud(scene_a, -10.0, 2.0, FourDofTransform(), 0.01, rng());
-    const std::vector<Eigen::Vector3d> source = Cloud(scene_b, -2.0, 10.0, kTruth.inverse(), 0.01, rng());
+    const std::vector<Eigen::Vector3d> scene_b = IcpTestScene(0.1, offset_b);
+    const std::vector<Eigen::Vector3d> target = IcpTestCloud(scene_a, -10.0, 2.0, FourDofTransform(), 0.01, rng());
+    const std::vector<Eigen::Vector3d> source = IcpTestCloud(scene_b, -2.0, 10.0, kTruth.inverse(), 0.01, rng());
     const Eigen::Vector3d dt = 0.2 * DrawVector3(unit, rng);
     const double dyaw = 3.0 * kDegree * unit(rng);
     const FourDofTransform start(kTruth.translation() + dt, kTruth.yaw() + dyaw);
@@ -156,7 +105,7 @@ double MeanNees(const FourDofIcpOptions& options, int trials, uint64_t seed) {
 }
 
 TEST(FourDofIcpTest, CovarianceIsConsistentOverNoisyTrials) {
-  const double nees = MeanNees(FourDofIcpOptions{}, 30, 17);
+  const double nees = MeanNees(IcpOptions{}, 30, 17);
   std::printf("mean NEES over 30 trials: %.2f (4 expected)\n", nees);
   // 30 trials: the mean of chi^2(4) has a standard deviation of 0.5.
   EXPECT_GT(nees, 2.0);
@@ -166,8 +115,8 @@ TEST(FourDofIcpTest, CovarianceIsConsistentOverNoisyTrials) {
 TEST(FourDofIcpTest, FlatPlaneIsDegenerate) {
   std::vector<Eigen::Vector3d> plane;
   SampleRect({-3.0, -3.0, 0.0}, {6.0, 0.0, 0.0}, {0.0, 6.0, 0.0}, 0.1, 0.5, &plane);
-  const std::vector<Eigen::Vector3d> target = Cloud(plane, -10.0, 10.0, FourDofTransform(), 0.01, 5);
-  const std::vector<Eigen::Vector3d> source = Cloud(plane, -10.0, 10.0, kTruth.inverse(), 0.01, 6);
+  const std::vector<Eigen::Vector3d> target = IcpTestCloud(plane, -10.0, 10.0, FourDofTransform(), 0.01, 5);
+  const std::vector<Eigen::Vector3d> source = IcpTestCloud(plane, -10.0, 10.0, kTruth.inverse(), 0.01, 6);
   const FourDofIcpResult r = FourDofIcp().Align(target, source, kTruth);
   EXPECT_FALSE(r.ok());
   EXPECT_TRUE(r.degenerate);
@@ -182,13 +131,13 @@ TEST(FourDofIcpTest, RollingGroundIsObservable) {
   std::vector<Eigen::Vector3d> ground;
   SampleRect({-4.0, -4.0, 0.0}, {8.0, 0.0, 0.0}, {0.0, 8.0, 0.0}, 0.05, 0.5, &ground);
   for (Eigen::Vector3d& p : ground) p.z() = 0.1 * std::sin(p.x() / 1.5) * std::cos(p.y() / 1.7) + 0.03 * p.x();
-  const std::vector<Eigen::Vector3d> target = Cloud(ground, -10.0, 10.0, FourDofTransform(), 0.01, 9);
-  const std::vector<Eigen::Vector3d> source = Cloud(ground, -10.0, 10.0, kTruth.inverse(), 0.01, 10);
+  const std::vector<Eigen::Vector3d> target = IcpTestCloud(ground, -10.0, 10.0, FourDofTransform(), 0.01, 9);
+  const std::vector<Eigen::Vector3d> source = IcpTestCloud(ground, -10.0, 10.0, kTruth.inverse(), 0.01, 10);
   const FourDofTransform start(kTruth.translation() + Eigen::Vector3d(0.05, -0.05, 0.0), kTruth.yaw() + 1.0 * kDegree);
   const FourDofIcpResult r = FourDofIcp().Align(target, source, start);
   std::printf("rolling ground: observability %.4f, %zu inliers\n", r.observability, r.inliers);
   ASSERT_TRUE(r.ok()) << r.status.ToString();
-  EXPECT_GT(r.observability, FourDofIcpOptions{}.min_observability);
+  EXPECT_GT(r.observability, IcpOptions{}.min_observability);
   EXPECT_LT(r.observability, 0.005);  // what the first threshold called degenerate
   EXPECT_LT((r.T_a_b.translation() - kTruth.translation()).norm(), 0.03);
   EXPECT_LT(std::abs(r.T_a_b.yaw() - kTruth.yaw()), 0.2 * kDegree);
@@ -198,25 +147,25 @@ TEST(FourDofIcpTest, SingleWallLeavesTheMotionAlongItFree) {
   std::vector<Eigen::Vector3d> corridor;
   SampleRect({-3.0, -3.0, 0.0}, {6.0, 0.0, 0.0}, {0.0, 6.0, 0.0}, 0.1, 0.5, &corridor);
   SampleRect({-3.0, 1.0, 0.0}, {6.0, 0.0, 0.0}, {0.0, 0.0, 1.5}, 0.1, 0.5, &corridor);
-  const std::vector<Eigen::Vector3d> target = Cloud(corridor, -10.0, 10.0, FourDofTransform(), 0.01, 7);
-  const std::vector<Eigen::Vector3d> source = Cloud(corridor, -10.0, 10.0, kTruth.inverse(), 0.01, 8);
+  const std::vector<Eigen::Vector3d> target = IcpTestCloud(corridor, -10.0, 10.0, FourDofTransform(), 0.01, 7);
+  const std::vector<Eigen::Vector3d> source = IcpTestCloud(corridor, -10.0, 10.0, kTruth.inverse(), 0.01, 8);
   const FourDofIcpResult r = FourDofIcp().Align(target, source, kTruth);
   EXPECT_FALSE(r.ok());
   EXPECT_TRUE(r.degenerate) << r.status.ToString();
 
   // A second wall across the first constrains it.
   SampleRect({-2.5, -3.0, 0.0}, {0.0, 4.0, 0.0}, {0.0, 0.0, 1.5}, 0.1, 0.5, &corridor);
-  const std::vector<Eigen::Vector3d> target2 = Cloud(corridor, -10.0, 10.0, FourDofTransform(), 0.01, 7);
-  const std::vector<Eigen::Vector3d> source2 = Cloud(corridor, -10.0, 10.0, kTruth.inverse(), 0.01, 8);
+  const std::vector<Eigen::Vector3d> target2 = IcpTestCloud(corridor, -10.0, 10.0, FourDofTransform(), 0.01, 7);
+  const std::vector<Eigen::Vector3d> source2 = IcpTestCloud(corridor, -10.0, 10.0, kTruth.inverse(), 0.01, 8);
   const FourDofIcpResult r2 = FourDofIcp().Align(target2, source2, kTruth);
   EXPECT_TRUE(r2.ok()) << r2.status.ToString();
   EXPECT_FALSE(r2.degenerate);
 }
 
 TEST(FourDofIcpTest, NonFinitePointsAreSkippedAndCounted) {
-  const std::vector<Eigen::Vector3d> scene = Scene(0.1, 0.5);
-  std::vector<Eigen::Vector3d> target = Cloud(scene, -10.0, 2.0, FourDofTransform(), 0.0, 1);
-  std::vector<Eigen::Vector3d> source = Cloud(scene, -2.0, 10.0, kTruth.inverse(), 0.0, 2);
+  const std::vector<Eigen::Vector3d> scene = IcpTestScene(0.1, 0.5);
+  std::vector<Eigen::Vector3d> target = IcpTestCloud(scene, -10.0, 2.0, FourDofTransform(), 0.0, 1);
+  std::vector<Eigen::Vector3d> source = IcpTestCloud(scene, -2.0, 10.0, kTruth.inverse(), 0.0, 2);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < target.size(); i += 50) target[i].x() = nan;
@@ -234,7 +183,7 @@ TEST(FourDofIcpTest, NonFinitePointsAreSkippedAndCounted) {
 }
 
 TEST(FourDofIcpTest, EmptyAndNonFiniteOnlyInputsAreReported) {
-  const std::vector<Eigen::Vector3d> scene = Scene(0.1, 0.5);
+  const std::vector<Eigen::Vector3d> scene = IcpTestScene(0.1, 0.5);
   const std::vector<Eigen::Vector3d> none;
   const FourDofIcpResult no_source = FourDofIcp().Align(scene, none, FourDofTransform());
   EXPECT_EQ(no_source.status.code(), StatusCode::kFailedPrecondition);
@@ -254,7 +203,7 @@ TEST(FourDofIcpTest, EmptyAndNonFiniteOnlyInputsAreReported) {
 }
 
 TEST(FourDofIcpTest, DisjointCloudsHaveTooFewOverlappingPoints) {
-  const std::vector<Eigen::Vector3d> scene = Scene(0.1, 0.5);
+  const std::vector<Eigen::Vector3d> scene = IcpTestScene(0.1, 0.5);
   const FourDofIcpResult r = FourDofIcp().Align(scene, scene, FourDofTransform(20.0, 0.0, 0.0, 0.0));
   EXPECT_EQ(r.status.code(), StatusCode::kNotFound);
   EXPECT_NE(r.status.message().find("too few overlapping points"), std::string::npos) << r.status.message();
@@ -262,10 +211,10 @@ TEST(FourDofIcpTest, DisjointCloudsHaveTooFewOverlappingPoints) {
 }
 
 TEST(FourDofIcpTest, IterationLimitIsReportedAsNotConverged) {
-  const std::vector<Eigen::Vector3d> scene = Scene(0.1, 0.5);
-  const std::vector<Eigen::Vector3d> target = Cloud(scene, -10.0, 2.0, FourDofTransform(), 0.0, 1);
-  const std::vector<Eigen::Vector3d> source = Cloud(scene, -2.0, 10.0, kTruth.inverse(), 0.0, 2);
-  FourDofIcpOptions o;
+  const std::vector<Eigen::Vector3d> scene = IcpTestScene(0.1, 0.5);
+  const std::vector<Eigen::Vector3d> target = IcpTestCloud(scene, -10.0, 2.0, FourDofTransform(), 0.0, 1);
+  const std::vector<Eigen::Vector3d> source = IcpTestCloud(scene, -2.0, 10.0, kTruth.inverse(), 0.0, 2);
+  IcpOptions o;
   o.max_iterations = 2;
   const FourDofIcpResult r = FourDofIcp(o).Align(target, source, Perturbed(kTruth));
   EXPECT_FALSE(r.ok());
@@ -274,7 +223,7 @@ TEST(FourDofIcpTest, IterationLimitIsReportedAsNotConverged) {
   EXPECT_EQ(r.status.code(), StatusCode::kTimeout);
   EXPECT_NE(r.status.message().find("not converged"), std::string::npos) << r.status.message();
 
-  FourDofIcpOptions bad;
+  IcpOptions bad;
   bad.min_correspondence_distance = 2.0;  // above max_correspondence_distance
   EXPECT_EQ(FourDofIcp(bad).Align(target, source, kTruth).status.code(), StatusCode::kInvalidArgument);
 }

@@ -6,64 +6,9 @@
 #include <random>
 #include <string>
 
+#include "mapping/matching/ransac_core.h"
+
 namespace cairn {
-namespace {
-
-// Uniform in [0, n) from the engine's raw output. Rejection keeps it unbiased and, unlike the
-// standard distributions, gives the same draws under every standard library.
-size_t DrawIndex(std::mt19937_64& rng, size_t n) {
-  constexpr uint64_t kMax = std::numeric_limits<uint64_t>::max();
-  const uint64_t range = n;
-  const uint64_t limit = kMax - kMax % range;  // a multiple of range
-  uint64_t r = rng();
-  while (r >= limit) r = rng();
-  return static_cast<size_t>(r % range);
-}
-
-struct Score {
-  size_t inliers = 0;
-  double sum_sq = 0.0;  // of the inliers' distances
-
-  bool BetterThan(const Score& o) const {
-    return inliers > o.inliers || (inliers == o.inliers && sum_sq < o.sum_sq);
-  }
-};
-
-Score Evaluate(const FourDofTransform& T, std::span<const Eigen::Vector3d> source,
-               std::span<const Eigen::Vector3d> target, std::span<const size_t> valid, double threshold_sq) {
-  Score s;
-  for (const size_t i : valid) {
-    const double d2 = (T * source[i] - target[i]).squaredNorm();
-    if (d2 <= threshold_sq) {
-      ++s.inliers;
-      s.sum_sq += d2;
-    }
-  }
-  return s;
-}
-
-void CollectInliers(const FourDofTransform& T, std::span<const Eigen::Vector3d> source,
-                    std::span<const Eigen::Vector3d> target, std::span<const size_t> valid,
-                    double threshold_sq, std::vector<size_t>* inliers) {
-  inliers->clear();
-  for (const size_t i : valid) {
-    if ((T * source[i] - target[i]).squaredNorm() <= threshold_sq) inliers->push_back(i);
-  }
-}
-
-// Samples needed to draw one pair of distinct inliers with probability `confidence` when `k` of
-// the `n` correspondences are inliers; at most `cap`.
-int64_t RequiredSamples(size_t k, size_t n, double confidence, int64_t cap) {
-  if (k < 2) return cap;
-  const double p_pair = (static_cast<double>(k) * static_cast<double>(k - 1)) /
-                        (static_cast<double>(n) * static_cast<double>(n - 1));
-  if (p_pair >= 1.0) return 1;
-  const double needed = std::ceil(std::log(1.0 - confidence) / std::log1p(-p_pair));
-  if (!(needed < static_cast<double>(cap))) return cap;
-  return std::max<int64_t>(1, static_cast<int64_t>(needed));
-}
-
-}  // namespace
 
 Status FourDofRansacOptions::Validate() const {
   if (!(inlier_threshold > 0.0)) return InvalidArgumentError("ransac: inlier_threshold must be > 0");
@@ -138,74 +83,15 @@ std::optional<FourDofTransform> FourDofRansac::FitLeastSquares(std::span<const E
 
 Expected<FourDofRansacResult> FourDofRansac::Estimate(std::span<const Eigen::Vector3d> source_b,
                                                       std::span<const Eigen::Vector3d> target_a) const {
-  CAIRN_RETURN_IF_ERROR(options_.Validate());
-  if (source_b.size() != target_a.size())
-    return InvalidArgumentError("ransac: " + std::to_string(source_b.size()) + " source points but " +
-                                std::to_string(target_a.size()) + " target points");
-  FourDofRansacResult result;
-  std::vector<size_t> valid;
-  valid.reserve(source_b.size());
-  for (size_t i = 0; i < source_b.size(); ++i) {
-    if (source_b[i].allFinite() && target_a[i].allFinite()) valid.push_back(i);
-  }
-  result.skipped_non_finite = source_b.size() - valid.size();
-  const size_t needed = static_cast<size_t>(std::max<int64_t>(2, options_.min_inliers));
-  if (valid.size() < needed)
-    return FailedPreconditionError("ransac: too few correspondences: " + std::to_string(valid.size()) +
-                                   " finite (" + std::to_string(result.skipped_non_finite) +
-                                   " non-finite skipped), need " + std::to_string(needed));
-
-  const double threshold_sq = options_.inlier_threshold * options_.inlier_threshold;
-  std::mt19937_64 rng(options_.seed);
-  Score best;
-  FourDofTransform best_T;
-  bool have_best = false;
-  int64_t required = options_.max_iterations;
-  int64_t it = 0;
-  for (; it < options_.max_iterations && it < required; ++it) {
+  const auto solve = [&](std::mt19937_64& rng, std::span<const size_t> valid) {
     // Two distinct indices, drawn one after the other (a fixed order whatever the compiler).
     const size_t i = DrawIndex(rng, valid.size());
     size_t j = DrawIndex(rng, valid.size() - 1);
     if (j >= i) ++j;
-    const std::optional<FourDofTransform> T =
-        SolveTwoPoint(source_b[valid[i]], source_b[valid[j]], target_a[valid[i]], target_a[valid[j]]);
-    if (!T) {
-      ++result.degenerate_samples;
-      continue;
-    }
-    const Score s = Evaluate(*T, source_b, target_a, valid, threshold_sq);
-    if (!have_best || s.BetterThan(best)) {
-      best = s;
-      best_T = *T;
-      have_best = true;
-      required = RequiredSamples(s.inliers, valid.size(), options_.confidence, options_.max_iterations);
-    }
-  }
-  result.iterations = it;
-  if (!have_best)
-    return NotFoundError("ransac: no consensus: all " + std::to_string(it) + " samples were degenerate");
-  if (best.inliers < static_cast<size_t>(options_.min_inliers))
-    return NotFoundError("ransac: no consensus: the best of " + std::to_string(it) + " hypotheses has " +
-                         std::to_string(best.inliers) + " inliers, need " +
-                         std::to_string(options_.min_inliers));
-
-  CollectInliers(best_T, source_b, target_a, valid, threshold_sq, &result.inliers);
-  std::vector<size_t> refit_inliers;
-  for (int64_t round = 0; round < options_.refine_rounds; ++round) {
-    const std::optional<FourDofTransform> T = FitLeastSquares(source_b, target_a, result.inliers);
-    if (!T) break;
-    const Score s = Evaluate(*T, source_b, target_a, valid, threshold_sq);
-    if (!s.BetterThan(best)) break;
-    best = s;
-    best_T = *T;
-    CollectInliers(best_T, source_b, target_a, valid, threshold_sq, &refit_inliers);
-    const bool same = refit_inliers == result.inliers;
-    result.inliers.swap(refit_inliers);
-    if (same) break;
-  }
-  result.T_a_b = best_T;
-  result.inlier_rms = std::sqrt(best.sum_sq / static_cast<double>(best.inliers));
-  return result;
+    return SolveTwoPoint(source_b[valid[i]], source_b[valid[j]], target_a[valid[i]], target_a[valid[j]]);
+  };
+  const auto fit = [&](std::span<const size_t> indices) { return FitLeastSquares(source_b, target_a, indices); };
+  return EstimateRansac<FourDofRansacResult>(options_, source_b, target_a, 2, solve, fit);
 }
 
 }  // namespace cairn

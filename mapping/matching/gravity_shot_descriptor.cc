@@ -7,6 +7,8 @@
 #include <Eigen/Geometry>
 #include <nanoflann.hpp>
 
+#include "estimation/math/symmetric_eigen.h"
+
 namespace cairn {
 namespace {
 
@@ -157,6 +159,7 @@ void NormalizeHalf(float* h, int n) {
 
 struct GravityShotDescriptor::Impl {
   GravityShotOptions options;
+  ShotFrame frame_kind = ShotFrame::kGravity;
   std::vector<Eigen::Vector3f> points;
   std::vector<Lab> lab;
   std::vector<Eigen::Vector3f> normals;
@@ -212,6 +215,38 @@ struct GravityShotDescriptor::Impl {
   }
 
   bool Compute(const Eigen::Vector3f& k, GravityShot* out, GravityShotFrame* frame);
+
+  // SHOT's frame from the support found last (see the header); false when its scatter has no
+  // distinct largest and smallest axes.
+  bool FullFrame(const Eigen::Vector3f& k, float radius, Eigen::Matrix3f* axes) const {
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    double sum_w = 0.0;
+    for (size_t j = 0; j < support.size(); ++j) {
+      const Eigen::Vector3d v = (points[support[j]] - k).cast<double>();
+      const double w = radius - support_d[j];
+      scatter.noalias() += w * v * v.transpose();
+      sum_w += w;
+    }
+    if (!(sum_w > 0.0)) return false;
+    Eigen::Vector3d values;
+    Eigen::Matrix3d vectors;
+    if (!SymmetricEigen(scatter / sum_w, &values, &vectors)) return false;
+    if (!(values(2) > values(1) * (1.0 + 1e-6)) || !(values(1) > values(0) * (1.0 + 1e-6))) return false;
+    Eigen::Vector3f x = vectors.col(2).cast<float>(), z = vectors.col(0).cast<float>();
+    // Each axis points to the side with more support points (ties keep the solver's sign).
+    int64_t x_balance = 0, z_balance = 0;
+    for (const uint32_t i : support) {
+      const Eigen::Vector3f v = points[i] - k;
+      x_balance += v.dot(x) >= 0.0f ? 1 : -1;
+      z_balance += v.dot(z) >= 0.0f ? 1 : -1;
+    }
+    if (x_balance < 0) x = -x;
+    if (z_balance < 0) z = -z;
+    axes->col(0) = x;
+    axes->col(1) = z.cross(x);
+    axes->col(2) = z;
+    return true;
+  }
 };
 
 bool GravityShotDescriptor::Impl::Compute(const Eigen::Vector3f& k, GravityShot* out,
@@ -261,6 +296,10 @@ bool GravityShotDescriptor::Impl::Compute(const Eigen::Vector3f& k, GravityShot*
   const double slope = std::hypot(slope_x, slope_y);
   const double angle = slope > 0.0 && std::isfinite(slope) ? std::atan2(slope_y, slope_x) : 0.0;
   const float cx = static_cast<float>(std::cos(angle)), cy = static_cast<float>(std::sin(angle));
+  const bool gravity = frame_kind == ShotFrame::kGravity;
+  Eigen::Matrix3f axes;
+  axes << cx, -cy, 0.0f, cy, cx, 0.0f, 0.0f, 0.0f, 1.0f;
+  if (!gravity && !FullFrame(k, radius, &axes)) return false;
 
   // Keypoint colour: mean of the points close to it, weighted down to 0 at keypoint_colour_radius,
   // else the nearest point's.
@@ -296,8 +335,9 @@ bool GravityShotDescriptor::Impl::Compute(const Eigen::Vector3f& k, GravityShot*
   for (size_t j = 0; j < n; ++j) {
     const uint32_t idx = support[j];
     const Eigen::Vector3f v = points[idx] - k;
-    const float lx = cx * v.x() + cy * v.y();
-    const float ly = -cy * v.x() + cx * v.y();
+    const float lx = gravity ? cx * v.x() + cy * v.y() : axes.col(0).dot(v);
+    const float ly = gravity ? -cy * v.x() + cx * v.y() : axes.col(1).dot(v);
+    const float lz = gravity ? v.z() : axes.col(2).dot(v);
     const float d = support_d[j];
     // Points fade out over the outer kAxisBlend of the sphere, so one crossing its surface by a
     // rounding error changes the descriptor by as little.
@@ -331,13 +371,16 @@ bool GravityShotDescriptor::Impl::Compute(const Eigen::Vector3f& k, GravityShot*
     // Elevation by the sine, two halves (both alike at the keypoint); radius, two shells.
     int e0, r0;
     float we1, wr1;
-    Interpolate(v.z() / std::max(d, kAxisBlend) + 0.5f, kShotElevationBins, &e0, &we1);
+    Interpolate(lz / std::max(d, kAxisBlend) + 0.5f, kShotElevationBins, &e0, &we1);
     Interpolate(d * shells_per_m - 0.5f, kShotRadialBins, &r0, &wr1);
 
     const Eigen::Vector3f* normal = Normal(idx);
     int s0 = 0;
     float ws1 = 0.0f;
-    if (normal != nullptr) Interpolate((*normal).z() * kShotShapeBins - 0.5f, kShotShapeBins, &s0, &ws1);
+    if (normal != nullptr) {
+      const float cosine = gravity ? normal->z() : std::abs(normal->dot(axes.col(2)));
+      Interpolate(cosine * kShotShapeBins - 0.5f, kShotShapeBins, &s0, &ws1);
+    }
     const Lab& c = lab[idx];
     const float dc = std::abs(c[0] - key_lab[0]) + std::abs(c[1] - key_lab[1]) + std::abs(c[2] - key_lab[2]);
     int c0;
@@ -369,18 +412,20 @@ bool GravityShotDescriptor::Impl::Compute(const Eigen::Vector3f& k, GravityShot*
   NormalizeHalf(shape, kShotVolumes * kShotShapeBins);
   NormalizeHalf(colour, kShotVolumes * kShotColourBins);
   if (frame != nullptr) {
-    frame->yaw = static_cast<float>(angle);
-    frame->slope = std::isfinite(slope) ? static_cast<float>(slope) : 0.0f;
+    frame->axes = axes;
+    frame->yaw = gravity ? static_cast<float>(angle) : std::atan2(axes(1, 0), axes(0, 0));
+    frame->slope = gravity && std::isfinite(slope) ? static_cast<float>(slope) : 0.0f;
     frame->support = static_cast<int32_t>(n);
   }
   return true;
 }
 
 GravityShotDescriptor::GravityShotDescriptor(const std::vector<CloudPoint>& cloud,
-                                             const GravityShotOptions& options)
+                                             const GravityShotOptions& options, ShotFrame frame)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.options = options;
+  m.frame_kind = frame;
   m.points.reserve(cloud.size());
   m.lab.reserve(cloud.size());
   for (const CloudPoint& c : cloud) {
@@ -409,6 +454,7 @@ bool GravityShotDescriptor::Compute(const Eigen::Vector3f& keypoint, GravityShot
 
 DescribedKeypoints GravityShotDescriptor::ComputeAll(const std::vector<Eigen::Vector3f>& keypoints) {
   DescribedKeypoints out;
+  out.gravity_frames = impl_->frame_kind == ShotFrame::kGravity;
   out.points.reserve(keypoints.size());
   out.descriptors.reserve(keypoints.size());
   out.frames.reserve(keypoints.size());

@@ -14,6 +14,12 @@
 // normal_radius and are oriented toward +z (no viewpoint is stored with a submap's points), which
 // leaves the cosine with gravity in [0, 1].
 //
+// The matcher's 6-DoF variant (submap_matcher.h) describes keypoints without gravity: its local
+// frame (ShotFrame::kFull) is the one SHOT defines, the eigenvectors of the support's scatter
+// about the keypoint (weights radius - distance; x the largest, z the smallest), each signed
+// toward the side that holds most support points, y = z x x; the normal cosine is taken with
+// that z, unsigned. Everything else is the same.
+//
 // Layout (kGravityShotSize floats): volumes indexed ((azimuth * 2 + elevation) * 2 + radius) with
 // 8 azimuth sectors about the frame's x, 2 elevation halves (below, above the keypoint) and 2
 // radial shells (split at half the radius); first the 32 normal-cosine histograms of
@@ -68,8 +74,11 @@ struct GravityShotOptions {
   }
 };
 
+enum class ShotFrame { kGravity, kFull };
+
 // The local reference frame of one descriptor.
 struct GravityShotFrame {
+  Eigen::Matrix3f axes = Eigen::Matrix3f::Identity();  // columns x, y, z in the submap frame
   float yaw = 0.0f;     // rad; of the frame's x axis in the submap frame
   float slope = 0.0f;   // rise over run of the support's plane; near 0 (flat), x is arbitrary
   int32_t support = 0;  // points in the sphere
@@ -81,6 +90,7 @@ struct DescribedKeypoints {
   std::vector<GravityShotFrame> frames;
   std::vector<uint32_t> keypoint_index;  // into the keypoints given
   int64_t dropped = 0;                   // keypoints with too small a support (or non-finite)
+  bool gravity_frames = true;            // ShotFrame::kGravity; else full 3-D frames
 
   size_t size() const { return points.size(); }
 };
@@ -88,8 +98,8 @@ struct DescribedKeypoints {
 class GravityShotDescriptor {
  public:
   // Indexes the finite points of `cloud` (copied; non-finite ones skipped and counted).
-  explicit GravityShotDescriptor(const std::vector<CloudPoint>& cloud,
-                                 const GravityShotOptions& options = {});
+  explicit GravityShotDescriptor(const std::vector<CloudPoint>& cloud, const GravityShotOptions& options = {},
+                                 ShotFrame frame = ShotFrame::kGravity);
   ~GravityShotDescriptor();
   GravityShotDescriptor(const GravityShotDescriptor&) = delete;
   GravityShotDescriptor& operator=(const GravityShotDescriptor&) = delete;

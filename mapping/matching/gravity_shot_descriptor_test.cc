@@ -73,6 +73,44 @@ TEST(GravityShotDescriptorTest, InvariantToYaw) {
   }
 }
 
+// The 6-DoF variant's frames follow any rotation, not only a yaw; the gravity frames do not.
+TEST(GravityShotDescriptorTest, FullFramesAreInvariantToAnyRotation) {
+  const testing::ScenePair pair = testing::OverlappingSubmaps(7, /*cast_rays=*/false);
+  const std::vector<CloudPoint>& cloud = pair.a->points();
+  const SubmapKeypoints k = KeypointExtractor().VoxelKeypoints(cloud);
+  GravityShotDescriptor base(cloud, {}, ShotFrame::kFull);
+  const DescribedKeypoints d0 = base.ComputeAll(k.points);
+  EXPECT_FALSE(d0.gravity_frames);
+  Eigen::Isometry3f T = Eigen::Isometry3f::Identity();
+  T.linear() = (Eigen::AngleAxisf(0.9f, Eigen::Vector3f::UnitZ()) * Eigen::AngleAxisf(0.3f, Eigen::Vector3f(1, 1, 0).normalized()))
+                   .toRotationMatrix();
+  T.translation() = Eigen::Vector3f(3.0f, -2.0f, 0.5f);
+  std::vector<CloudPoint> turned = cloud;
+  for (CloudPoint& c : turned) c.p = T * c.p;
+  GravityShotDescriptor full(turned, {}, ShotFrame::kFull), level(turned);
+  const DescribedKeypoints d_level0 = GravityShotDescriptor(cloud).ComputeAll(k.points);
+  int checked = 0, same = 0, same_frame = 0, same_level = 0;
+  for (size_t i = 0; i < d0.size(); ++i) {
+    GravityShot d;
+    GravityShotFrame f;
+    if (!full.Compute(T * d0.points[i], &d, &f)) continue;
+    ++checked;
+    if (GravityShotDescriptor::Distance(d0.descriptors[i], d) < 1e-3) ++same;
+    if ((f.axes - T.linear() * d0.frames[i].axes).cwiseAbs().maxCoeff() < 1e-3f) ++same_frame;
+    GravityShot g;
+    if (level.Compute(T * d0.points[i], &g) && i < d_level0.size() &&
+        GravityShotDescriptor::Distance(d_level0.descriptors[i], g) < 1e-3)
+      ++same_level;
+  }
+  std::printf("[ tilt    ] full frames: %d of %d descriptors and %d frames unchanged; gravity frames: %d\n", same,
+              checked, same_frame, same_level);
+  ASSERT_GT(checked, 200);
+  // A few keypoints have two nearly equal axes, where the frame may flip under rounding.
+  EXPECT_GE(same, checked * 95 / 100);
+  EXPECT_GE(same_frame, checked * 95 / 100);
+  EXPECT_LT(same_level, checked / 10);
+}
+
 // Two submaps of the same place with their own noise, voxel grid and origin: the descriptor at a
 // place in A is nearest to the descriptor at the same place in B.
 TEST(GravityShotDescriptorTest, SamePlaceIsNearestAcrossSubmaps) {

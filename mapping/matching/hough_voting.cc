@@ -46,7 +46,10 @@ void HoughVoting::VoteOneWay(const DescribedKeypoints& from, const DescribedKeyp
   ref /= static_cast<double>(from.points.size());
 
   const double inv_bin = 1.0 / options_.translation_bin;
-  const int yaw_bins = std::max(1, static_cast<int>(std::lround(kTwoPi / options_.yaw_bin)));
+  // Full 3-D frames (the 6-DoF variant): the votes are the predicted reference points only, as in
+  // Hough3D, since a yaw alone does not say the rotation.
+  const bool gravity = from.gravity_frames && to.gravity_frames;
+  const int yaw_bins = gravity ? std::max(1, static_cast<int>(std::lround(kTwoPi / options_.yaw_bin))) : 1;
   const double yaw_width = kTwoPi / yaw_bins;
 
   // Continuous bin coordinates of each vote: bin i spans [i - 0.5, i + 0.5).
@@ -61,11 +64,14 @@ void HoughVoting::VoteOneWay(const DescribedKeypoints& from, const DescribedKeyp
     const KeypointCorrespondence& c = correspondences[i];
     const uint32_t f = a_in_b ? c.a : c.b, t = a_in_b ? c.b : c.a;
     if (f >= from.points.size() || t >= to.points.size()) continue;
-    const double yaw = static_cast<double>(to.frames[t].yaw) - static_cast<double>(from.frames[f].yaw);
+    const double yaw =
+        gravity ? static_cast<double>(to.frames[t].yaw) - static_cast<double>(from.frames[f].yaw) : 0.0;
     const double cy = std::cos(yaw), sy = std::sin(yaw);
     const Eigen::Vector3d e = ref - from.points[f].cast<double>();
-    const Eigen::Vector3d pred = to.points[t].cast<double>() +
-                                 Eigen::Vector3d(cy * e.x() - sy * e.y(), sy * e.x() + cy * e.y(), e.z());
+    const Eigen::Vector3d turned =
+        gravity ? Eigen::Vector3d(cy * e.x() - sy * e.y(), sy * e.x() + cy * e.y(), e.z())
+                : Eigen::Vector3d((to.frames[t].axes * from.frames[f].axes.transpose()).cast<double>() * e);
+    const Eigen::Vector3d pred = to.points[t].cast<double>() + turned;
     VotePos& v = pos[i];
     v.q = {pred.x() * inv_bin - 0.5, pred.y() * inv_bin - 0.5, pred.z() * inv_bin - 0.5,
            WrapTwoPi(yaw) / yaw_width - 0.5};
@@ -161,14 +167,22 @@ HoughResult HoughVoting::Vote(const DescribedKeypoints& a, const DescribedKeypoi
                    [](const HoughCluster& p, const HoughCluster& q) { return p.votes > q.votes; });
   if (result.clusters.empty()) return result;
 
-  // Each cluster's transform T_b_a: circular mean of the members' yaws, then the mean offset.
+  // Each cluster's transform T_b_a: circular mean of the members' yaws (with full frames, the
+  // yaw of their mean rotation matrix), then the mean offset.
+  const bool gravity = a.gravity_frames && b.gravity_frames;
   for (HoughCluster& cluster : result.clusters) {
     double s = 0.0, c = 0.0;
     for (uint32_t m : cluster.members) {
       const KeypointCorrespondence& k = correspondences[m];
-      const double yaw = static_cast<double>(b.frames[k.b].yaw) - static_cast<double>(a.frames[k.a].yaw);
-      s += std::sin(yaw);
-      c += std::cos(yaw);
+      if (gravity) {
+        const double yaw = static_cast<double>(b.frames[k.b].yaw) - static_cast<double>(a.frames[k.a].yaw);
+        s += std::sin(yaw);
+        c += std::cos(yaw);
+      } else {
+        const Eigen::Matrix3f R = b.frames[k.b].axes * a.frames[k.a].axes.transpose();
+        s += R(1, 0);
+        c += R(0, 0);
+      }
     }
     const double yaw = std::atan2(s, c);
     const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();

@@ -10,6 +10,9 @@
 // surrounding bins. As in the thesis the voting runs both ways, A's centroid predicted in B and
 // B's in A, because the spread of a vote grows with the distance of its keypoint from the
 // reference point, which differs between the two.
+//
+// Keypoints with full 3-D frames (the matcher's 6-DoF variant, gravity_shot_descriptor.h) predict
+// the reference point through the rotation between their frames and vote in x, y, z only.
 
 #include <cstdint>
 #include <vector>

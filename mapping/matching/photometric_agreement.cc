@@ -20,8 +20,12 @@ PhotometricAgreement::PhotometricAgreement(const std::vector<Eigen::Vector3d>& c
 
 PhotometricScore PhotometricAgreement::Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
                                              const FourDofTransform& T_a_b) const {
+  return Score(cloud, grey, T_a_b.ToIsometry());
+}
+
+PhotometricScore PhotometricAgreement::Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
+                                             const Eigen::Isometry3d& T) const {
   PhotometricScore out;
-  const Eigen::Isometry3d T = T_a_b.ToIsometry();
   const size_t n = std::min(cloud.size(), grey.size());
   // Sums about the first pair's values, so that the variances do not cancel catastrophically.
   double a0 = 0.0, b0 = 0.0, sa = 0.0, sb = 0.0, saa = 0.0, sbb = 0.0, sab = 0.0;

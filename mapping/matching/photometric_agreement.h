@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "mapping/matching/four_dof_transform.h"
 #include "mapping/voxel_hash_map.h"
@@ -32,6 +33,8 @@ class PhotometricAgreement {
   // B's cloud and grey levels under T_a_b.
   PhotometricScore Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
                          const FourDofTransform& T_a_b) const;
+  PhotometricScore Score(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
+                         const Eigen::Isometry3d& T_a_b) const;
 
  private:
   float inverse_voxel_ = 20.0f;

@@ -38,7 +38,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   }
 
   const auto describe_start = std::chrono::steady_clock::now();
-  GravityShotDescriptor descriptor(submap.points(), options_.descriptor);
+  GravityShotDescriptor descriptor(submap.points(), options_.descriptor, frame_);
   f.described = descriptor.ComputeAll(f.keypoints.points);
   f.descriptor_ms = MillisecondsSince(describe_start);
   return f;

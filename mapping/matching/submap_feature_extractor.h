@@ -47,7 +47,9 @@ struct SubmapFeatures {
 
 class SubmapFeatureExtractor {
  public:
-  explicit SubmapFeatureExtractor(const SubmapFeatureOptions& options = {}) : options_(options) {}
+  // kFull: descriptors for the matcher's 6-DoF variant (gravity_shot_descriptor.h).
+  explicit SubmapFeatureExtractor(const SubmapFeatureOptions& options = {}, ShotFrame frame = ShotFrame::kGravity)
+      : options_(options), frame_(frame) {}
 
   // Never fails: a submap that cannot be matched (too small, keypoints on a line, nothing
   // finite) comes back unsuitable with the reason, and without descriptors.
@@ -55,6 +57,7 @@ class SubmapFeatureExtractor {
 
  private:
   SubmapFeatureOptions options_;
+  ShotFrame frame_;
 };
 
 }  // namespace cairn

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "common/elapsed.h"
+#include "mapping/matching/six_dof_icp.h"
+#include "mapping/matching/six_dof_ransac.h"
 
 namespace cairn {
 namespace {
@@ -21,7 +23,8 @@ std::string Format(const char* format, auto... args) {
 }
 
 struct Hypothesis {
-  FourDofTransform T_a_b;
+  FourDofTransform T_a_b;   // in 6-DoF, the x, y, z and yaw of T_full
+  Eigen::Isometry3d T_full = Eigen::Isometry3d::Identity();
   std::vector<uint32_t> a_keypoints, b_keypoints;  // of the RANSAC inliers
   size_t inliers = 0;
   double rms = 0.0;
@@ -79,6 +82,43 @@ Verdict JudgeGrey(const PhotometricScore& score, double min_ncc, int64_t min_pai
   return Verdict::kAgree;
 }
 
+// One ICP refinement in either variant: the transform, its x, y, z, yaw covariance, and how far
+// it moved from the hypothesis.
+struct Refinement {
+  Status status;
+  FourDofTransform T_a_b;
+  Eigen::Isometry3d T_full = Eigen::Isometry3d::Identity();
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+  size_t inliers = 0;
+  double rms = 0.0;
+  int64_t iterations = 0;
+  double shift = 0.0;  // m
+  double turn = 0.0;   // rad
+};
+
+Refinement Refine4(const FourDofIcp& icp, const SubmapFeatures& a, const SubmapFeatures& b, const Hypothesis& h) {
+  const FourDofIcpResult fit = icp.Align(a.cloud, b.cloud, h.T_a_b);
+  Refinement out{fit.status, fit.T_a_b, fit.T_a_b.ToIsometry(), fit.covariance, fit.inliers, fit.rms, fit.iterations};
+  const FourDofTransform moved = h.T_a_b.inverse() * fit.T_a_b;
+  out.shift = moved.translation().norm();
+  out.turn = std::abs(moved.yaw());
+  return out;
+}
+
+Refinement Refine6(const SixDofIcp& icp, const SubmapFeatures& a, const SubmapFeatures& b, const Hypothesis& h) {
+  const SixDofIcpResult fit = icp.Align(a.cloud, b.cloud, h.T_full);
+  Refinement out{fit.status, FourDofTransform::ProjectIsometry(fit.T_a_b), fit.T_a_b, Eigen::Matrix4d::Zero(),
+                 fit.inliers, fit.rms, fit.iterations};
+  // x, y, z and the rotation about A's z: the 4-DoF parameters, to first order in the tilt.
+  static constexpr int kKeep[4] = {0, 1, 2, 5};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) out.covariance(i, j) = fit.covariance(kKeep[i], kKeep[j]);
+  const Eigen::Isometry3d moved = h.T_full.inverse() * fit.T_a_b;
+  out.shift = moved.translation().norm();
+  out.turn = Eigen::AngleAxisd(moved.linear()).angle();
+  return out;
+}
+
 }  // namespace
 
 std::string_view MatchStatusName(MatchStatus status) {
@@ -134,6 +174,10 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   if (Status s = options_.Validate(); !s.ok()) return finish(MatchStatus::kNoMatch, s.message());
   if (!a.suitable()) return finish(MatchStatus::kUnsuitable, "submap A: " + a.suitability.message);
   if (!b.suitable()) return finish(MatchStatus::kUnsuitable, "submap B: " + b.suitability.message);
+  const bool six = !a.described.gravity_frames;
+  r.dof = six ? 6 : 4;
+  if (a.described.gravity_frames != b.described.gravity_frames)
+    return finish(MatchStatus::kNoMatch, "submaps described for different variants (4-DoF and 6-DoF)");
 
   // Correspondences and votes.
   Clock::time_point stage = Clock::now();
@@ -151,6 +195,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   // One RANSAC per cluster; gate and spread checks per hypothesis.
   stage = Clock::now();
   const FourDofRansac ransac(options_.ransac);
+  const SixDofRansac ransac6(options_.ransac);
   SuitabilityOptions spread_options;
   spread_options.off_line_distance = options_.off_line_distance;
   const SubmapSuitability spread(spread_options);
@@ -160,7 +205,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   std::vector<Eigen::Vector3f> inlier_points;
   std::optional<PhotometricAgreement> photometric;  // A's grey levels, built for the first check
   PhotometricScore last_grey;
-  const auto Judge = [&](double min_ncc, const FourDofTransform& T_a_b, std::string* why) {
+  const auto Judge = [&](double min_ncc, const auto& T_a_b, std::string* why) {
     if (min_ncc <= -1.0) {
       last_grey = PhotometricScore{};
       *why = "grey levels not checked";
@@ -193,18 +238,36 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       source_b.push_back(b.described.points[c.b].cast<double>());
       target_a.push_back(a.described.points[c.a].cast<double>());
     }
-    Expected<FourDofRansacResult> fit = ransac.Estimate(source_b, target_a);
-    if (!fit.ok()) {
-      rejections.Add("clusters without consensus", Format("cluster of %zu votes: %s", cluster.members.size(),
-                                                          fit.status().message().c_str()));
+    Hypothesis h;
+    std::vector<size_t> inliers;
+    Status consensus;
+    if (six) {
+      Expected<SixDofRansacResult> fit = ransac6.Estimate(source_b, target_a);
+      consensus = fit.status();
+      if (fit.ok()) {
+        h.T_full = fit->T_a_b;
+        h.T_a_b = FourDofTransform::ProjectIsometry(h.T_full);
+        h.rms = fit->inlier_rms;
+        inliers = std::move(fit->inliers);
+      }
+    } else {
+      Expected<FourDofRansacResult> fit = ransac.Estimate(source_b, target_a);
+      consensus = fit.status();
+      if (fit.ok()) {
+        h.T_a_b = fit->T_a_b;
+        h.T_full = h.T_a_b.ToIsometry();
+        h.rms = fit->inlier_rms;
+        inliers = std::move(fit->inliers);
+      }
+    }
+    if (!consensus.ok()) {
+      rejections.Add("clusters without consensus",
+                     Format("cluster of %zu votes: %s", cluster.members.size(), consensus.message().c_str()));
       continue;
     }
     ++r.hypotheses;
-    Hypothesis h;
-    h.T_a_b = fit->T_a_b;
-    h.inliers = fit->inliers.size();
-    h.rms = fit->inlier_rms;
-    for (const size_t i : fit->inliers) {
+    h.inliers = inliers.size();
+    for (const size_t i : inliers) {
       const KeypointCorrespondence& c = correspondences[cluster.members[i]];
       h.a_keypoints.push_back(c.a);
       h.b_keypoints.push_back(c.b);
@@ -217,7 +280,8 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     }
     // The grey levels judge the hypothesis where they can; where they cannot (no texture, little
     // overlap, the check off) the spread of its keypoints must rule out a slide along a line.
-    const Verdict grey = Judge(options_.min_hypothesis_ncc, h.T_a_b, &why);
+    const Verdict grey = six ? Judge(options_.min_hypothesis_ncc, h.T_full, &why)
+                             : Judge(options_.min_hypothesis_ncc, h.T_a_b, &why);
     if (grey == Verdict::kDisagree) {
       ++r.photometric_rejected;
       rejections.Add("hypotheses whose grey levels disagree", "hypothesis: " + why);
@@ -241,24 +305,24 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   // Refinement on the full clouds.
   stage = Clock::now();
   const FourDofIcp icp(options_.icp);
+  const SixDofIcp icp6(options_.icp);
   const size_t tries = std::min(hypotheses.size(), static_cast<size_t>(options_.max_refined_hypotheses));
   for (size_t k = 0; k < tries; ++k) {
     const Hypothesis& h = hypotheses[k];
     ++r.refined;
-    const FourDofIcpResult fit = icp.Align(a.cloud, b.cloud, h.T_a_b);
+    const Refinement fit = six ? Refine6(icp6, a, b, h) : Refine4(icp, a, b, h);
     r.icp_inliers = fit.inliers;
     r.icp_rms = fit.rms;
     r.icp_iterations = fit.iterations;
     r.ransac_inliers = h.inliers;
-    if (!fit.ok()) {
+    if (!fit.status.ok()) {
       rejections.Add("refinements failed", fit.status.message());
       continue;
     }
-    const FourDofTransform moved = h.T_a_b.inverse() * fit.T_a_b;
-    const double shift = moved.translation().norm();
     std::string why;
-    if (shift > options_.max_refinement_translation || std::abs(moved.yaw()) > options_.max_refinement_yaw) {
-      rejections.Add("refinements moved too far", Format("icp left the hypothesis by %.3f m and %.3f rad", shift, std::abs(moved.yaw())));
+    if (fit.shift > options_.max_refinement_translation || fit.turn > options_.max_refinement_yaw) {
+      rejections.Add("refinements moved too far",
+                     Format("icp left the hypothesis by %.3f m and %.3f rad", fit.shift, fit.turn));
     } else if (fit.rms > options_.max_icp_rms) {
       rejections.Add("refinements with a high residual",
                      Format("icp residual %.3f m above %.3f m", fit.rms, options_.max_icp_rms));
@@ -267,7 +331,9 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
                                                           static_cast<long long>(options_.min_icp_inliers)));
     } else if (prior.has_value() && !WithinGate(fit.T_a_b, *prior, &why)) {
       rejections.Add("refinements outside the gate", "refined match " + why);
-    } else if (const Verdict grey = Judge(options_.min_match_ncc, fit.T_a_b, &why); grey == Verdict::kDisagree) {
+    } else if (const Verdict grey = six ? Judge(options_.min_match_ncc, fit.T_full, &why)
+                                        : Judge(options_.min_match_ncc, fit.T_a_b, &why);
+               grey == Verdict::kDisagree) {
       ++r.photometric_rejected;
       r.photometric = last_grey;
       rejections.Add("refinements whose grey levels disagree", "refined match: " + why);
@@ -277,6 +343,8 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     } else {
       r.photometric = last_grey;
       r.T_a_b = fit.T_a_b;
+      r.T_a_b_full = fit.T_full;
+      r.tilt = FourDofTransform::TiltOf(fit.T_full.linear());
       r.covariance = fit.covariance;
       const double ft = options_.covariance_floor_translation, fy = options_.covariance_floor_yaw;
       r.covariance.diagonal() += Eigen::Vector4d(ft * ft, ft * ft, ft * ft, fy * fy);

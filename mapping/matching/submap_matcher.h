@@ -6,7 +6,13 @@
 // best surviving hypothesis, gated and checked photometrically again.
 //
 // The result is T_a_b (B's origin in A's frame) with its covariance from the ICP (x, y, z, yaw,
-// see four_dof_icp.h). Every rejection says which check failed and by how much, because matches
+// see four_dof_icp.h).
+//
+// The 6-DoF variant (thesis 6.1 compares it) runs when both submaps' features were described
+// with full 3-D frames (SubmapFeatureExtractor with ShotFrame::kFull): Hough votes in x, y, z,
+// three-point RANSAC (six_dof_ransac.h) and a 6-DoF ICP (six_dof_icp.h), with the same gate,
+// spread and photometric checks and options. Gravity is then used nowhere; the result also holds
+// the full transform and its tilt, and T_a_b and the covariance are its x, y, z and yaw. Every rejection says which check failed and by how much, because matches
 // that fail are remembered by the pairing and shared with teammates.
 
 #include <cstdint>
@@ -15,6 +21,7 @@
 #include <string_view>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "common/options_visitor.h"
 #include "common/status.h"
@@ -32,7 +39,7 @@ struct SubmapMatcherOptions {
   CorrespondenceFinderOptions correspondences;
   HoughVotingOptions hough;
   FourDofRansacOptions ransac;
-  FourDofIcpOptions icp;
+  IcpOptions icp;
   // Hypotheses and the refined match must lie within gate_sigmas standard deviations of the
   // relative estimate in each of x, y, z and yaw (thesis: 2, on x, y, z). The floors stand for the
   // matcher's own error, so a relative estimate known better than the matcher cannot veto it.
@@ -123,6 +130,9 @@ struct SubmapMatchResult {
   size_t spread_rejected = 0;  // hypotheses whose keypoints lie on a line
   size_t photometric_rejected = 0;  // hypotheses and refinements whose grey levels disagree
   size_t refined = 0;          // hypotheses handed to the ICP
+  int dof = 4;                 // 6: the variant without gravity
+  Eigen::Isometry3d T_a_b_full = Eigen::Isometry3d::Identity();  // = T_a_b in 4-DoF
+  double tilt = 0.0;           // rad; angle between A's z and B's z under T_a_b_full
   size_t ransac_inliers = 0;   // of the hypothesis the match came from
   size_t icp_inliers = 0;
   double icp_rms = 0.0;

@@ -86,6 +86,27 @@ TEST_F(SubmapMatcherTest, RecoversTheTrueTransformWithoutAGuess) {
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(r.covariance).eigenvalues().minCoeff(), 0.0);
 }
 
+// The variant without gravity finds the same match, with no tilt; it refuses to pair features of
+// the two variants.
+TEST_F(SubmapMatcherTest, SixDofVariantRecoversTheTrueTransform) {
+  const SubmapFeatureExtractor extractor({}, ShotFrame::kFull);
+  const SubmapFeatures a = extractor.Extract(*pair_->a), b = extractor.Extract(*pair_->b);
+  const SubmapMatchResult r = SubmapMatcher().Match(a, b);
+  Print("6-DoF", r);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_EQ(r.dof, 6);
+  const FourDofTransform truth = TruthOf(*pair_).T_a_b;
+  EXPECT_LT((r.T_a_b.translation() - truth.translation()).norm(), 0.05);
+  EXPECT_LT(YawError(r.T_a_b, truth), 0.5 * kDegree);
+  EXPECT_LT(r.tilt, 0.5 * kDegree);
+  EXPECT_LT((r.T_a_b_full.translation() - r.T_a_b.translation()).norm(), 1e-12);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(r.covariance).eigenvalues().minCoeff(), 0.0);
+
+  const SubmapMatchResult mixed = SubmapMatcher().Match(a, *features_b_);
+  EXPECT_EQ(mixed.status, MatchStatus::kNoMatch);
+  EXPECT_NE(mixed.reason.find("different variants"), std::string::npos) << mixed.reason;
+}
+
 TEST_F(SubmapMatcherTest, MatchesTheOtherWayRoundToTheInverse) {
   const SubmapMatchResult ab = SubmapMatcher().Match(*features_a_, *features_b_);
   const SubmapMatchResult ba = SubmapMatcher().Match(*features_b_, *features_a_);
