@@ -57,7 +57,7 @@ YAML::Node YamlOptionsReader::Lookup(std::string_view key) {
   YAML::Node child = map[std::string(key)];
   if (!child.IsDefined() || child.IsNull()) {
     const std::string full = FullKey(key);
-    errors_.push_back(Where(frame.node, frame.path) + ": missing key '" + full + "'");
+    (earlier_versions_ ? notes_ : errors_).push_back(Where(frame.node, frame.path) + ": missing key '" + full + "'");
     return YAML::Node(YAML::NodeType::Undefined);
   }
   return child;
@@ -197,7 +197,7 @@ void YamlOptionsReader::ReportUnknownKeys(const Frame& frame) {
     const std::string key = item.first.as<std::string>("");
     if (frame.consumed.count(key) != 0) continue;
     const std::string full = frame.path.empty() ? key : frame.path + "." + key;
-    errors_.push_back(Where(item.first, full) + ": unknown key '" + full + "'");
+    (earlier_versions_ ? notes_ : errors_).push_back(Where(item.first, full) + ": unknown key '" + full + "'");
   }
 }
 

@@ -34,6 +34,11 @@ class YamlOptionsReader final : public OptionsVisitor {
 
   const std::vector<std::string>& errors() const { return errors_; }
 
+  // For a copy written by an earlier version (an output folder's config.yaml): missing keys keep
+  // their defaults and unknown keys are skipped, each listed in notes() instead of failing.
+  void AcceptEarlierVersions() { earlier_versions_ = true; }
+  const std::vector<std::string>& notes() const { return notes_; }
+
   void Number(std::string_view key, double& value, double min, double max,
               std::string_view unit) override;
   void Flag(std::string_view key, bool& value) override;
@@ -68,6 +73,8 @@ class YamlOptionsReader final : public OptionsVisitor {
   std::set<std::string> overridden_;
   std::vector<Frame> stack_;
   std::vector<std::string> errors_;
+  std::vector<std::string> notes_;
+  bool earlier_versions_ = false;
 };
 
 // Loads a YAML file (or reports where it does not parse), applies `key.path=value` overrides and

@@ -103,6 +103,29 @@ TEST(YamlOptionsReaderTest, ReportsAllErrorsNotJustTheFirst) {
   EXPECT_NE(s.message().find("'mode'"), std::string::npos);
 }
 
+// An earlier version's copy: keys added since keep their defaults, keys removed since are
+// skipped, both noted; a value out of range still fails.
+TEST(YamlOptionsReaderTest, EarlierVersionsKeepDefaultsForKeysTheyLack) {
+  Outer o;
+  YamlOptionsReader r(YAML::Load("depth: 8\non: true\nname: x\ninner: {xy: [0, 1], old: 2}\n"), "test.yaml");
+  r.AcceptEarlierVersions();
+  ASSERT_TRUE(r.Read(o).ok());
+  EXPECT_EQ(o.depth, 8);
+  EXPECT_EQ(o.mode, Mode::kA);
+  EXPECT_DOUBLE_EQ(o.inner.gain, 1.0);
+  ASSERT_EQ(r.notes().size(), 3u);
+  EXPECT_NE(r.notes()[0].find("missing key 'mode'"), std::string::npos) << r.notes()[0];
+  EXPECT_NE(r.notes()[1].find("missing key 'inner.gain'"), std::string::npos) << r.notes()[1];
+  EXPECT_NE(r.notes()[2].find("test.yaml:4:21: unknown key 'inner.old'"), std::string::npos) << r.notes()[2];
+
+  YamlOptionsReader bad(YAML::Load("depth: 99\n"), "test.yaml");
+  bad.AcceptEarlierVersions();
+  const Status s = bad.Read(o);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("key 'depth' = 99 is outside"), std::string::npos) << s.message();
+  EXPECT_EQ(s.message().find("missing"), std::string::npos) << s.message();
+}
+
 TEST(YamlOptionsReaderTest, OverriddenKeysAreBlamedOnTheCommandLine) {
   Outer o;
   const Status s = Read("depth: 99\non: true\nname: x\nmode: a\ninner: {gain: 1, xy: [0, 1]}\n", &o, {"depth"});

@@ -4,13 +4,17 @@
 
 namespace cairn {
 
-Expected<CairndOptions> LoadCairndOptions(const std::string& path,
-                                          const std::vector<std::string>& overrides) {
+namespace {
+
+Expected<CairndOptions> Load(const std::string& path, const std::vector<std::string>& overrides,
+                             std::vector<std::string>* earlier_version_notes) {
   auto doc = LoadYamlWithOverrides(path, overrides);
   if (!doc.ok()) return doc.status();
   CairndOptions options;
   YamlOptionsReader reader(doc->root, path, doc->overridden_keys);
+  if (earlier_version_notes != nullptr) reader.AcceptEarlierVersions();
   CAIRN_RETURN_IF_ERROR(reader.Read(options));
+  if (earlier_version_notes != nullptr) *earlier_version_notes = reader.notes();
   if (options.mapping.enabled && !(options.stereo.enabled && options.vo.enabled)) {
     return InvalidArgumentError(path + ": mapping.enabled needs stereo.enabled (dense depth) and vo.enabled "
                                        "(the filter's poses)");
@@ -23,6 +27,17 @@ Expected<CairndOptions> LoadCairndOptions(const std::string& path,
                                        "letter in graph keys)");
   }
   return options;
+}
+
+}  // namespace
+
+Expected<CairndOptions> LoadCairndOptions(const std::string& path,
+                                          const std::vector<std::string>& overrides) {
+  return Load(path, overrides, nullptr);
+}
+
+Expected<CairndOptions> LoadEarlierRunOptions(const std::string& path, std::vector<std::string>* notes) {
+  return Load(path, {}, notes);
 }
 
 }  // namespace cairn

@@ -16,7 +16,9 @@ Expected<SimulatedMapAccuracy> ScoreSimulatedMap(const std::string& dir, const E
   for (const std::string& p : {map_path, config_path}) {
     if (!std::filesystem::exists(p)) return NotFoundError(p + ": missing");
   }
-  auto options = LoadCairndOptions(config_path, {});
+  SimulatedMapAccuracy a;
+  // An earlier version may have written the config: the world and robots are what matter here.
+  auto options = LoadEarlierRunOptions(config_path, &a.config_notes);
   if (!options.ok()) return options.status();
   auto mission = OpenSimulatedMission(*options, config_path);
   if (!mission.ok()) return mission.status();
@@ -28,7 +30,6 @@ Expected<SimulatedMapAccuracy> ScoreSimulatedMap(const std::string& dir, const E
   if (!read) return InvalidArgumentError(map_path + " is not an OctoMap binary tree");
   // Robots move 0.3-2 m/s; every 0.1 s places their bodies within a voxel or two of any instant.
   const sim::SurfaceDistance truth(**mission, 0.1);
-  SimulatedMapAccuracy a;
   a.voxel = tree.getResolution();
   for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
     if (!tree.isNodeOccupied(*it)) continue;

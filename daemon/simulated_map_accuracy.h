@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -17,6 +18,9 @@ struct SimulatedMapAccuracy {
   int64_t occupied = 0;  // occupied leaves at the finest level
   int64_t near = 0;      // ...within one voxel of a true surface
   double voxel = 0.0;    // m
+  // Keys of the run's config.yaml that this version does not know or misses (an earlier version
+  // wrote it); defaults were used for the missing ones.
+  std::vector<std::string> config_notes;
   double fraction() const { return occupied > 0 ? static_cast<double>(near) / static_cast<double>(occupied) : 0.0; }
 };
 

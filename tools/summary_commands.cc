@@ -67,6 +67,10 @@ void PrintMapAccuracy(const std::string& dir, const Eigen::Isometry3d& T_world_m
     std::printf("  map vs world: %lld occupied voxels, %.1f %% within one voxel (%.2f m) of a true surface\n",
                 static_cast<long long>(a->occupied), 100.0 * a->fraction(), a->voxel);
   }
+  if (a.ok() && !a->config_notes.empty()) {
+    std::printf("  note: config.yaml is from another version: %zu keys missing or unknown, defaults used (first: %s)\n",
+                a->config_notes.size(), a->config_notes.front().c_str());
+  }
 }
 
 // The longest of summary.json's streams (the mission's data), or 0 when there is none.
