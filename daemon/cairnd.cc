@@ -24,6 +24,7 @@
 #include "drivers/replay/euroc_replay.h"
 #include "drivers/replay/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
+#include "drivers/xsens_imu_driver.h"
 #include "estimation/graph/g2o_io.h"
 
 namespace cairn {
@@ -122,10 +123,22 @@ Status Cairnd::Prepare() {
   if (options_.can.enabled && options_.source == SourceKind::kLive) {
     sources_.push_back(std::make_unique<SocketCanWheelDriver>(options_.can));
   }
+  // So is the IMU; a port that is absent at start is reported and retried by the driver.
+  if (options_.imu.enabled && options_.source == SourceKind::kLive) {
+    imu_calibration_ = options_.imu.Calibration();
+    sources_.push_back(std::make_unique<XsensImuDriver>(options_.imu.xsens, *imu_calibration_));
+  }
+  if (options_.source == SourceKind::kLive) {
+    // Say what a live robot lacks, once, before it runs without it.
+    spdlog::warn("{}: no stereo camera driver is built yet: live runs record and stream the IMU and wheels, "
+                 "estimation and mapping wait for cameras",
+                 config_path_);
+  }
   if (sources_.empty()) {
     return InvalidArgumentError(config_path_ +
-                                ": no sensor source is enabled (this build has replay and SocketCAN "
-                                "wheel odometry; camera and IMU device drivers are not built yet)");
+                                ": no sensor source is enabled (this build has replay, the simulator, SocketCAN "
+                                "wheel odometry (can.enabled) and the Xsens IMU (imu.enabled); camera drivers are "
+                                "not built yet)");
   }
   // Only once the sources are good: a start that fails moves nothing.
   KeepEarlierRun();

@@ -18,6 +18,7 @@
 #include "daemon/telemetry/live_stream_options.h"
 #include "daemon/telemetry/recording_options.h"
 #include "drivers/can_wheel_options.h"
+#include "drivers/imu_device_options.h"
 #include "drivers/replay/replay_options.h"
 #include "estimation/filter/filter_options.h"
 #include "estimation/vo/vo_options.h"
@@ -103,6 +104,7 @@ struct CairndOptions {
   ReplayOptions replay;
   SimSourceOptions sim;
   CanWheelOptions can;
+  ImuDeviceOptions imu;
   ExecutorsOptions executors;
   QueueOptions queues;
   DaemonOptions daemon;
@@ -126,6 +128,7 @@ struct CairndOptions {
     v.Section("replay", replay);
     v.Section("sim", sim);
     v.Section("can", can);
+    v.Section("imu", imu);
     v.Section("executors", executors);
     v.Section("queues", queues);
     v.Section("daemon", daemon);

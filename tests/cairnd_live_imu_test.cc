@@ -1,0 +1,79 @@
+// cairnd with `source: live` on the rover profile, its Xsens IMU an emulated MTi on a
+// pseudo-terminal (drivers/testing/emulated_mti.h): the daemon configures the device, consumes its
+// samples at the device's rate, reports the device vanishing and coming back, and exits cleanly on
+// SIGTERM with the IMU stream and the faults in summary.json. The CAN bus and cameras are absent
+// here, and it says so.
+
+#include <signal.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "common/json_value.h"
+#include "drivers/testing/emulated_mti.h"
+#include "tests/support/process_runner.h"
+#include "tests/support/test_data.h"
+
+namespace cairn {
+namespace {
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(CairndLiveImuTest, TheRoverProfileRunsLiveOnItsXsensImu) {
+  const std::string dir = testing::FreshTempDir("live_imu");
+  const std::string link = dir + "/mti";
+  auto device = testing::EmulatedMti::Create(link);
+  ASSERT_TRUE(device.ok()) << device.status().ToString();
+  // Halfway through, the device is unplugged and plugged in again under the same name.
+  std::jthread replug([&](std::stop_token stop) {
+    const auto until = [&](double s) {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+      while (!stop.stop_requested() && std::chrono::steady_clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    };
+    until(2.0);
+    (*device)->Vanish();
+    until(0.5);
+    auto again = testing::EmulatedMti::Create(link);
+    if (again.ok()) *device = std::move(*again);
+  });
+  testing::ProcessOptions po;
+  po.signal = SIGTERM;
+  po.signal_after = std::chrono::milliseconds(4500);
+  po.timeout = std::chrono::milliseconds(60000);
+  const testing::ProcessResult r = testing::RunProcess(
+      {testing::BinaryDir() + "/daemon/cairnd", "--config", testing::SourceDir() + "/configs/rover.yaml", "--out",
+       dir + "/out", "--set", "can.enabled=false", "--set", "imu.xsens.device=" + link, "--set",
+       "imu.xsens.rate_hz=200", "--set", "imu.xsens.reopen_interval=0.1", "--set", "live.enabled=false", "--set",
+       "recording.enabled=false", "--set", "team.enabled=false", "--set", "daemon.status_interval=0.5"},
+      po);
+  replug.request_stop();
+  replug.join();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("no stereo camera driver is built yet"), std::string::npos) << r.output;
+
+  const JsonValue summary = JsonValue::Parse(ReadFile(dir + "/out/summary.json"));
+  EXPECT_EQ(summary["mode"].string(), "live");
+  const JsonValue& imu = summary["streams"]["imu"];
+  // Up to 4 s of 200 Hz samples, less the half second unplugged and the start-up (slow under the
+  // sanitizers).
+  EXPECT_GT(imu["count"].number(), 200) << ReadFile(dir + "/out/summary.json");
+  EXPECT_NEAR(imu["nominal_rate_hz"].number(), 200.0, 1e-9);
+  EXPECT_EQ(imu["out_of_order"].number(), 0);
+  const JsonValue& faults = summary["faults"];
+  EXPECT_EQ(faults["by_device"][link]["disconnected"].number(), 1) << ReadFile(dir + "/out/summary.json");
+  EXPECT_EQ(imu["gaps"].number(), 1);  // the half second unplugged
+  EXPECT_EQ((*device)->configurations(), 1u);  // the device plugged in again was configured
+}
+
+}  // namespace
+}  // namespace cairn
