@@ -24,6 +24,7 @@
 #include "drivers/replay/euroc_replay.h"
 #include "drivers/replay/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
+#include "drivers/iio_imu_driver.h"
 #include "drivers/xsens_imu_driver.h"
 #include "estimation/graph/g2o_io.h"
 
@@ -126,7 +127,11 @@ Status Cairnd::Prepare() {
   // So is the IMU; a port that is absent at start is reported and retried by the driver.
   if (options_.imu.enabled && options_.source == SourceKind::kLive) {
     imu_calibration_ = options_.imu.Calibration();
-    sources_.push_back(std::make_unique<XsensImuDriver>(options_.imu.xsens, *imu_calibration_));
+    if (options_.imu.driver == ImuDriverKind::kIio) {
+      sources_.push_back(std::make_unique<IioImuDriver>(options_.imu.iio, *imu_calibration_));
+    } else {
+      sources_.push_back(std::make_unique<XsensImuDriver>(options_.imu.xsens, *imu_calibration_));
+    }
   }
   if (options_.source == SourceKind::kLive) {
     // Say what a live robot lacks, once, before it runs without it.
@@ -137,8 +142,8 @@ Status Cairnd::Prepare() {
   if (sources_.empty()) {
     return InvalidArgumentError(config_path_ +
                                 ": no sensor source is enabled (this build has replay, the simulator, SocketCAN "
-                                "wheel odometry (can.enabled) and the Xsens IMU (imu.enabled); camera drivers are "
-                                "not built yet)");
+                                "wheel odometry (can.enabled) and Xsens or IIO IMUs (imu.enabled); camera drivers "
+                                "are not built yet)");
   }
   // Only once the sources are good: a start that fails moves nothing.
   KeepEarlierRun();

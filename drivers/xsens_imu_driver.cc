@@ -102,6 +102,7 @@ void XsensImuDriver::Stop() {
     thread_.request_stop();
     thread_.join();
   }
+  Close();  // the reader thread owned the device until now
 }
 
 void XsensImuDriver::Close() {

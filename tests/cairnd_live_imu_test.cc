@@ -1,10 +1,11 @@
-// cairnd with `source: live` on the rover profile, its Xsens IMU an emulated MTi on a
-// pseudo-terminal (drivers/testing/emulated_mti.h): the daemon configures the device, consumes its
-// samples at the device's rate, reports the device vanishing and coming back, and exits cleanly on
-// SIGTERM with the IMU stream and the faults in summary.json. The CAN bus and cameras are absent
-// here, and it says so.
+// cairnd with `source: live` on the robot profiles' IMUs: the rover's Xsens as an emulated MTi on a
+// pseudo-terminal (drivers/testing/emulated_mti.h), the hexacopter's ADIS16407 as a fake IIO
+// device (drivers/testing/fake_iio_imu.h). The daemon sets the device up, consumes its samples,
+// reports the device vanishing and coming back, and exits cleanly on SIGTERM with the IMU stream
+// and the faults in summary.json. The CAN bus and cameras are absent here, and it says so.
 
 #include <signal.h>
+#include <time.h>
 
 #include <chrono>
 #include <fstream>
@@ -15,6 +16,7 @@
 
 #include "common/json_value.h"
 #include "drivers/testing/emulated_mti.h"
+#include "drivers/testing/fake_iio_imu.h"
 #include "tests/support/process_runner.h"
 #include "tests/support/test_data.h"
 
@@ -73,6 +75,41 @@ TEST(CairndLiveImuTest, TheRoverProfileRunsLiveOnItsXsensImu) {
   EXPECT_EQ(faults["by_device"][link]["disconnected"].number(), 1) << ReadFile(dir + "/out/summary.json");
   EXPECT_EQ(imu["gaps"].number(), 1);  // the half second unplugged
   EXPECT_EQ((*device)->configurations(), 1u);  // the device plugged in again was configured
+}
+
+TEST(CairndLiveImuTest, TheHexacopterProfileRunsLiveOnItsIioImu) {
+  const std::string dir = testing::FreshTempDir("live_iio");
+  const std::string sys = dir + "/sys", dev = dir + "/dev";
+  auto device = testing::FakeIioImu::Create(sys, dev);
+  ASSERT_TRUE(device.ok()) << device.status().ToString();
+  // 2 s of records at 200 Hz, written as the kernel would hand them out, then silence.
+  std::jthread writer([&](std::stop_token stop) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 0; i < 400 && !stop.stop_requested(); ++i) {
+      std::this_thread::sleep_until(start + std::chrono::microseconds(5000 * i));
+      const int16_t accel[3] = {0, 0, 301}, gyro[3] = {1, 2, 3};
+      timespec now{};
+      clock_gettime(CLOCK_MONOTONIC, &now);
+      (*device)->Write(testing::FakeIioImu::Record(accel, gyro, now.tv_sec * 1'000'000'000LL + now.tv_nsec));
+    }
+  });
+  testing::ProcessOptions po;
+  po.signal = SIGTERM;
+  po.signal_after = std::chrono::milliseconds(3000);
+  po.timeout = std::chrono::milliseconds(60000);
+  const testing::ProcessResult r = testing::RunProcess(
+      {testing::BinaryDir() + "/daemon/cairnd", "--config", testing::SourceDir() + "/configs/hexacopter.yaml", "--out",
+       dir + "/out", "--set", "imu.iio.sysfs_root=" + sys, "--set", "imu.iio.dev_root=" + dev, "--set",
+       "live.enabled=false", "--set", "recording.enabled=false", "--set", "team.enabled=false"},
+      po);
+  writer.request_stop();
+  writer.join();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ((*device)->CheckSetup("204.8", "64", false), "");  // set up, and the buffer off again at the end
+  const JsonValue summary = JsonValue::Parse(ReadFile(dir + "/out/summary.json"));
+  const JsonValue& imu = summary["streams"]["imu"];
+  EXPECT_GT(imu["count"].number(), 100) << ReadFile(dir + "/out/summary.json");
+  EXPECT_EQ(imu["out_of_order"].number(), 0);
 }
 
 }  // namespace
