@@ -17,7 +17,7 @@ Timestamp DeviceClockMapper::Map(int64_t device_time, Timestamp arrival) {
   const int64_t index = device_time / bucket_ns;
   if (buckets_.empty() || buckets_.back().index != index) {
     buckets_.push_back({index, device_time, difference});
-    while (static_cast<int>(buckets_.size()) > std::max(1, options_.buckets)) buckets_.pop_front();
+    if (static_cast<int>(buckets_.size()) > std::max(1, options_.buckets)) buckets_.erase(buckets_.begin());
   } else if (difference < buckets_.back().lowest) {
     buckets_.back().device_time = device_time;
     buckets_.back().lowest = difference;

@@ -9,8 +9,9 @@
 // previous sample's (while the fit settles its offset falls). Device time going
 // backwards (a reset) or jumping by more than `max_gap` starts the fit again, counted.
 
+#include <algorithm>
 #include <cstdint>
-#include <deque>
+#include <vector>
 
 #include "common/timestamp.h"
 
@@ -24,7 +25,9 @@ struct DeviceClockMapperOptions {
 
 class DeviceClockMapper {
  public:
-  explicit DeviceClockMapper(const DeviceClockMapperOptions& options = {}) : options_(options) {}
+  explicit DeviceClockMapper(const DeviceClockMapperOptions& options = {}) : options_(options) {
+    buckets_.reserve(static_cast<size_t>(std::max(1, options_.buckets)) + 1);  // none allocated per sample
+  }
 
   // The host time of a sample taken at `device_time` (ns on the device's clock, unwrapped) that
   // arrived at `arrival`.
@@ -42,7 +45,7 @@ class DeviceClockMapper {
   };
 
   DeviceClockMapperOptions options_;
-  std::deque<Bucket> buckets_;
+  std::vector<Bucket> buckets_;  // oldest first
   bool started_ = false;
   int64_t last_device_time_ = 0;
   bool have_output_ = false;
