@@ -114,6 +114,18 @@ void XsensImuDriver::Fault(DeviceFaultKind kind, const std::string& detail) {
   if (sink_ != nullptr) sink_->OnDeviceFault(DeviceFault{clock_.Now(), name(), kind, detail});
 }
 
+void XsensImuDriver::FormatFault(const std::string& detail, Timestamp now) {
+  ++format_faults_unreported_;
+  if (have_format_report_ && now - last_format_report_ < Duration::Seconds(1.0)) return;
+  Fault(DeviceFaultKind::kCorruptSample,
+        format_faults_unreported_ > 1
+            ? detail + " (" + std::to_string(format_faults_unreported_) + " messages since the last report)"
+            : detail);
+  format_faults_unreported_ = 0;
+  have_format_report_ = true;
+  last_format_report_ = now;
+}
+
 Status XsensImuDriver::Command(std::stop_token stop, uint8_t mid, std::span<const uint8_t> payload) {
   const std::vector<uint8_t> bytes = XbusFramer::Encode(mid, payload);
   size_t written = 0;
@@ -190,7 +202,12 @@ void XsensImuDriver::OnMessage(const XbusMessage& m, Timestamp arrival) {
   auto s = Mtdata2Decoder::Decode(m.payload);
   if (!s.ok()) {
     corrupt_.fetch_add(1, std::memory_order_relaxed);
-    Fault(DeviceFaultKind::kCorruptSample, s.status().message());
+    // A format this driver does not read comes with every message: say so once a second.
+    if (s.status().code() == StatusCode::kFailedPrecondition) {
+      FormatFault(s.status().message() + " (set configure: true)", arrival);
+    } else {
+      Fault(DeviceFaultKind::kCorruptSample, s.status().message());
+    }
     return;
   }
   if (s->has_counter) {
@@ -207,8 +224,9 @@ void XsensImuDriver::OnMessage(const XbusMessage& m, Timestamp arrival) {
   }
   if (!s->has_acceleration || !s->has_rate_of_turn) {
     corrupt_.fetch_add(1, std::memory_order_relaxed);
-    Fault(DeviceFaultKind::kCorruptSample, "MTData2 without acceleration and rate of turn (check the device's output "
-                                           "configuration, or set configure: true)");
+    FormatFault("MTData2 without acceleration and rate of turn (check the device's output configuration, or set "
+                "configure: true)",
+                arrival);
     return;
   }
   ImuSample sample;

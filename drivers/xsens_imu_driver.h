@@ -60,6 +60,9 @@ class XsensImuDriver final : public ImuInterface {
   Status Command(std::stop_token stop, uint8_t mid, std::span<const uint8_t> payload);
   void OnMessage(const XbusMessage& m, Timestamp arrival);
   void Fault(DeviceFaultKind kind, const std::string& detail);
+  // Messages the driver cannot use at all (a format or output it does not read) arrive with every
+  // sample: reported at most once a second, with the count.
+  void FormatFault(const std::string& detail, Timestamp now);
   void Close();
 
   XsensImuOptions options_;
@@ -80,6 +83,9 @@ class XsensImuDriver final : public ImuInterface {
   int awaited_ack_ = -1;
   bool acked_ = false;
   std::string device_error_;
+  bool have_format_report_ = false;
+  Timestamp last_format_report_;
+  uint64_t format_faults_unreported_ = 0;
   std::atomic<uint64_t> samples_{0}, corrupt_{0}, lost_{0}, reconnections_{0}, configurations_{0};
   std::jthread thread_;
 };

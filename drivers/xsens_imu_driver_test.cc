@@ -167,5 +167,27 @@ TEST_F(XsensImuDriverTest, AMissingPortOrARefusedConfigurationIsReportedAndRetri
   EXPECT_FALSE(XsensImuDriver(bad, ImuCalibration{}).Start(&sink_).ok());
 }
 
+// A device left with an output this driver cannot use (configure: false): every message is refused
+// and counted, but reported once a second, not two hundred times.
+TEST_F(XsensImuDriverTest, AnUnusableOutputIsReportedOnceASecond) {
+  XsensImuOptions o = Options(link_);
+  o.configure = false;
+  o.timeout = 60.0;
+  device_->SendOrientationOnly(true);
+  device_->StartMeasuring();
+  XsensImuDriver driver(o, ImuCalibration{});
+  ASSERT_TRUE(driver.Start(&sink_).ok());
+  ASSERT_TRUE(sink_.WaitFor([&] { return sink_.faults.size() >= 2; }));
+  driver.Stop();
+  std::lock_guard lock(sink_.mutex);
+  EXPECT_TRUE(sink_.imu.empty());
+  // Over a second of 100 Hz messages, all counted, two or three reports.
+  EXPECT_LE(sink_.faults.size(), 3u);
+  EXPECT_GT(driver.counts().corrupt, 30u * sink_.faults.size());
+  EXPECT_NE(sink_.faults[1].detail.find("messages since the last report"), std::string::npos) << sink_.faults[1].detail;
+  EXPECT_NE(sink_.faults[0].detail.find("without acceleration and rate of turn"), std::string::npos)
+      << sink_.faults[0].detail;
+}
+
 }  // namespace
 }  // namespace cairn

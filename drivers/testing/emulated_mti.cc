@@ -65,6 +65,8 @@ void EmulatedMti::SendRaw(std::span<const uint8_t> bytes) {
 void EmulatedMti::SkipPackets(int count) { skip_ += count; }
 void EmulatedMti::SetSilent(bool silent) { silent_ = silent; }
 void EmulatedMti::RefuseConfiguration(bool refuse) { refuse_ = refuse; }
+void EmulatedMti::StartMeasuring() { measuring_ = true; }
+void EmulatedMti::SendOrientationOnly(bool only) { orientation_only_ = only; }
 
 void EmulatedMti::Vanish() {
   if (thread_.joinable()) {
@@ -158,11 +160,16 @@ void EmulatedMti::Run(std::stop_token stop) {
             static_cast<uint8_t>(ticks)};
     PutPacket(&payload, 0x1060, data);
     data.clear();
-    for (const float v : {0.01f * static_cast<float>(n), -0.02f, 9.81f}) PutFloat(&data, v);
-    PutPacket(&payload, 0x4020, data);
-    data.clear();
-    for (const float v : {0.1f, -0.2f, 0.001f * static_cast<float>(n)}) PutFloat(&data, v);
-    PutPacket(&payload, 0x8020, data);
+    if (orientation_only_) {
+      for (const float v : {1.0f, 0.0f, 0.0f, 0.0f}) PutFloat(&data, v);
+      PutPacket(&payload, 0x2010, data);
+    } else {
+      for (const float v : {0.01f * static_cast<float>(n), -0.02f, 9.81f}) PutFloat(&data, v);
+      PutPacket(&payload, 0x4020, data);
+      data.clear();
+      for (const float v : {0.1f, -0.2f, 0.001f * static_cast<float>(n)}) PutFloat(&data, v);
+      PutPacket(&payload, 0x8020, data);
+    }
     data = {0, 0, 0, 3};
     PutPacket(&payload, 0xE020, data);
     Write(XbusFramer::Encode(0x36, payload));

@@ -31,6 +31,8 @@ class EmulatedMti {
   void SetSilent(bool silent);                  // stops streaming without closing
   void RefuseConfiguration(bool refuse);        // answer SetOutputConfiguration with an error
   void Vanish();                                // closes the pty: the port hangs up
+  void StartMeasuring();                        // as a device that kept its stored configuration
+  void SendOrientationOnly(bool only);          // a quaternion instead of the inertial data
 
   uint64_t samples_sent() const { return samples_.load(); }
   uint64_t configurations() const { return configurations_.load(); }
@@ -43,7 +45,7 @@ class EmulatedMti {
   void Write(std::span<const uint8_t> bytes);
 
   int master_ = -1;
-  std::atomic<bool> silent_{false}, refuse_{false}, measuring_{false};
+  std::atomic<bool> silent_{false}, refuse_{false}, measuring_{false}, orientation_only_{false};
   std::atomic<int> skip_{0};
   std::atomic<double> rate_hz_{100.0};
   std::atomic<uint64_t> samples_{0}, configurations_{0};
