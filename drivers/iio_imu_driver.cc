@@ -139,7 +139,11 @@ Status IioImuDriver::Open() {
   CAIRN_RETURN_IF_ERROR(WriteText(d + "/buffer/enable", "1"));
   const std::string dev = options_.dev_root + "/" + std::filesystem::path(d).filename().string();
   fd_ = open(dev.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd_ < 0) return UnavailableError(dev + ": " + std::strerror(errno));
+  if (fd_ < 0) {
+    const int e = errno;
+    (void)WriteText(d + "/buffer/enable", "0");  // nobody will read it
+    return UnavailableError(dev + ": " + std::strerror(e));
+  }
   buffer_.assign(layout_.record_size() * 64, 0);
   buffered_ = 0;
   last_timestamp_ = 0;

@@ -163,6 +163,7 @@ Status XsensImuDriver::Command(std::stop_token stop, uint8_t mid, std::span<cons
   }
   awaited_ack_ = -1;
   if (!device_error_.empty()) return FailedPreconditionError(device_error_);
+  if (!acked_) return Status(StatusCode::kCancelled, "stopped while configuring");
   return Status::Ok();
 }
 
