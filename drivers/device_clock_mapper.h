@@ -44,6 +44,9 @@ class DeviceClockMapper {
     int64_t lowest = 0;       // arrival - device time, ns
   };
 
+  // The least-squares line through the finished buckets, refitted only when one finishes.
+  void Refit();
+
   DeviceClockMapperOptions options_;
   std::vector<Bucket> buckets_;  // oldest first
   bool started_ = false;
@@ -52,6 +55,9 @@ class DeviceClockMapper {
   int64_t last_output_ = 0;  // ns, host time of the previous sample
   double offset_s_ = 0.0;
   double drift_ = 0.0;  // s per s
+  bool line_valid_ = false;
+  double line_t0_ = 0.0;         // ns, device time of the oldest bucket's lowest sample
+  double line_intercept_ = 0.0;  // ns, offset at line_t0_
   int64_t restarts_ = 0;
 };
 

@@ -61,10 +61,7 @@ IioImuDriver::IioImuDriver(IioImuOptions options, ImuCalibration calibration)
   if (options_.rate_hz > 0.0) calibration_.rate_hz = options_.rate_hz;
 }
 
-IioImuDriver::~IioImuDriver() {
-  Stop();
-  Close();
-}
+IioImuDriver::~IioImuDriver() { Stop(); }  // Stop() closes the device
 
 Expected<std::string> IioImuDriver::FindDevice(const std::string& sysfs_root, const std::string& name) {
   std::error_code ec;

@@ -53,10 +53,7 @@ XsensImuDriver::XsensImuDriver(XsensImuOptions options, ImuCalibration calibrati
   calibration_.rate_hz = options_.rate_hz;
 }
 
-XsensImuDriver::~XsensImuDriver() {
-  Stop();
-  Close();
-}
+XsensImuDriver::~XsensImuDriver() { Stop(); }  // Stop() closes the device
 
 XsensImuCounts XsensImuDriver::counts() const {
   return {samples_.load(), corrupt_.load(), lost_.load(), reconnections_.load(), configurations_.load()};
