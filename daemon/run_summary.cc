@@ -188,6 +188,8 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("images", r.images).Field("bad_images", r.bad_images).Field("tags", r.tags);
     j.Field("full_scans", r.full_scans).Field("region_scans", r.region_scans).Field("regions", r.regions);
     j.Field("idle", r.idle).Field("tags_in_regions", r.tags_in_regions);
+    j.Field("predictions", r.predictions).Field("predicted_regions", r.predicted_regions);
+    j.Field("tags_in_predicted_regions", r.tags_in_predicted_regions);
     j.Field("own_tags", r.own_tags).Field("unknown_ids", r.unknown_ids).Field("pose_failures", r.pose_failures);
     j.Field("usable", r.usable).Field("refused", r.refused);
     if (const GraphStage* graph = p.graph()) {

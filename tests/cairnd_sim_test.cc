@@ -2,6 +2,7 @@
 // daemon as a user runs it (`cairnd --config configs/rover.yaml --sim`), and the errors a wrong
 // simulation setup gives before anything runs.
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -50,6 +51,29 @@ TEST(CairndSimTest, RoverPublishesEveryStreamAndWritesGroundTruth) {
   auto truth = TrajectoryIo::Read(out + "/ground_truth.tum", TrajectoryFormat::kTum);
   ASSERT_TRUE(truth.ok()) << truth.status().ToString();
   EXPECT_EQ(truth->poses.size(), 401u);
+}
+
+// Deployed from the lander, the rover sights it while it initializes: in a live run the graph then
+// hands the detector where it places the rover (and the lander) for every image; a deterministic
+// replay, where that would depend on thread timing, does without.
+TEST(CairndSimTest, TheGraphPlacesTheCarriersForTheDetectorInLiveRunsOnly) {
+  const std::string out = testing::FreshTempDir("cairnd_sim_predictions");
+  for (const std::string deterministic : {"false", "true"}) {
+    auto args = SimArgs("rover", out + "/" + deterministic);
+    *std::find(args.begin(), args.end(), "sim.duration=2") = "sim.duration=3";
+    *std::find(args.begin(), args.end(), "sim.image_scale=0.25") = "sim.image_scale=0.5";  // the tag's cells
+    *std::find(args.begin(), args.end(), "replay.deterministic=true") = "replay.deterministic=" + deterministic;
+    args.insert(args.end(), {"--set", "sim.deploy_from_lander=true"});
+    const auto r = RunProcess(args);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const JsonValue d = JsonValue::ParseFile(out + "/" + deterministic + "/summary.json")["detection"];
+    EXPECT_GT(d["graph_landmark_observations"].number(), 0) << deterministic;
+    if (deterministic == "false") {
+      EXPECT_GT(d["predictions"].number(), 0);
+    } else {
+      EXPECT_EQ(d["predictions"].number(), 0);
+    }
+  }
 }
 
 TEST(CairndSimTest, HexacopterHasNoWheels) {

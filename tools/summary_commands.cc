@@ -245,12 +245,14 @@ int RunSummary(const CommandArgs& args) {
         };  // older runs lack some
         std::printf(
             "  detection: %.0f images scanned whole, %.0f in regions around tracked tags (%.0f of the tags "
-            "found there), %.0f tags of teammates or landmarks (%.0f usable, %.0f refused); "
+            "found there), %.0f regions where the graph placed a carrier (%.0f tags found there), "
+            "%.0f tags of teammates or landmarks (%.0f usable, %.0f refused); "
             "in the graph %.0f robot detections d (%.0f as IPPE's other minimum, %.0f refused against "
             "gravity), "
             "%.0f landmark observations o, %.0f pending, %.0f unplaced\n",
             d.has("full_scans") ? d["full_scans"].number() : d["images"].number(), count("region_scans"),
-            count("tags_in_regions"), d["tags"].number(), d["usable"].number(), d["refused"].number(),
+            count("tags_in_regions"), count("predicted_regions"), count("tags_in_predicted_regions"),
+            d["tags"].number(), d["usable"].number(), d["refused"].number(),
             d["graph_detections"].number(), count("graph_flipped"), count("graph_against_gravity"),
             d["graph_landmark_observations"].number(), d["graph_pending"].number(),
             d["graph_unplaced"].number());

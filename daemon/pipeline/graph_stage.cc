@@ -585,6 +585,27 @@ std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins(char robot) const
   return out;
 }
 
+bool GraphStage::LatestGlobalPose(char robot, StampedPose* out) const {
+  const uint32_t run = LatestRun(robot);
+  const std::vector<Placed>* placed = Estimates(robot, run);
+  if (placed == nullptr || placed->empty() || !Connected(robot, run)) return false;
+  const Placed& e = placed->back();
+  const auto origin = graph_.Pose(VariableKey(VariableKind::kSubmap, robot, e.frame_id));
+  if (!origin.ok()) return false;
+  *out = StampedPose{e.time, ToIsometry(*origin) * e.T_frame_body};
+  return true;
+}
+
+bool GraphStage::LandmarkGlobalPose(size_t index, Eigen::Isometry3d* T_global_landmark) const {
+  const uint64_t key = VariableKey(VariableKind::kLandmark, '*', static_cast<uint64_t>(index));
+  const auto pose = graph_.Pose(key);
+  if (!pose.ok()) return false;
+  const std::vector<uint64_t> loose = graph_.Unconnected();
+  if (std::find(loose.begin(), loose.end(), key) != loose.end()) return false;
+  *T_global_landmark = ToIsometry(*pose);
+  return true;
+}
+
 Trajectory GraphStage::GlobalTrajectory() const { return GlobalTrajectory(robot_); }
 
 Trajectory GraphStage::GlobalTrajectory(char robot) const { return GlobalTrajectory(robot, LatestRun(robot)); }

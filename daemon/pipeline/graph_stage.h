@@ -112,6 +112,12 @@ class GraphStage {
   // `robot`'s estimates placed by its origins; empty when it is not connected (never guessed).
   Trajectory GlobalTrajectory(char robot) const;  // its latest run
   Trajectory GlobalTrajectory(char robot, uint32_t run) const;
+  // The latest estimate of `robot`'s latest run, in the global frame; false when the graph has none
+  // or cannot place it (its origins are not tied to this robot's).
+  bool LatestGlobalPose(char robot, StampedPose* out) const;
+  // Landmark `index` (of SetLandmarks) in the global frame; false when not observed yet or not tied
+  // to this robot's origins.
+  bool LandmarkGlobalPose(size_t index, Eigen::Isometry3d* T_global_landmark) const;
   // The origins of every robot in the graph with, when `covariances`, their marginal covariances
   // (a covariance solve).
   std::vector<OriginEstimate> OriginEstimates(bool covariances);

@@ -108,6 +108,14 @@ Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrie
   auto model = RobotDetectionStage::MakeErrorModel(options, error_table_path, rectify_->camera());
   if (!model.ok()) return model.status();
   graph_->SetLandmarks(table.Landmarks());
+  landmark_carriers_ = table.Landmarks();
+  for (const auto& [id, mount] : table.tags()) {
+    if (mount.landmark || mount.carrier == robot) continue;
+    if (std::find(robot_carriers_.begin(), robot_carriers_.end(), mount.carrier) == robot_carriers_.end())
+      robot_carriers_.push_back(mount.carrier);
+  }
+  // A deterministic replay must not depend on how far the graph thread got by each image.
+  predict_carriers_ = options.predicted_regions && !deterministic_;
   detection_ = std::make_unique<RobotDetectionStage>(options, std::move(table), std::move(*model), rectify_->camera(),
                                                      rectify_->T_body_cam(), robot, graph_->robot());
   // Whole-frame scans on every every_nth_frame-th frame, region scans on every
@@ -523,12 +531,17 @@ void Pipeline::ShowTeamSubmaps() {
 void Pipeline::DetectionLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { detection_signal_.Notify(); });
   std::vector<TagSighting> found;
+  CarrierPredictions predictions;
   while (true) {
     const uint32_t seen = detection_signal_.sequence();
     bool worked = false;
     while (const auto* queued = detection_queue_.Front()) {
       found.clear();
-      detection_->Process(queued->value, &found);
+      if (predict_carriers_) {
+        const std::lock_guard lock(predictions_mutex_);
+        predictions = predictions_;
+      }
+      detection_->Process(queued->value, predict_carriers_ ? &predictions : nullptr, &found);
       for (TagSighting& s : found) {
         if (deterministic_) {
           while (!sighting_queue_.TryPush(s)) std::this_thread::yield();
@@ -545,6 +558,33 @@ void Pipeline::DetectionLoop(std::stop_token stop) {
     if (stop.stop_requested() && detection_queue_.empty()) return;
     if (!worked) detection_signal_.WaitChange(seen);
   }
+}
+
+void Pipeline::PublishPredictions() {
+  CarrierPredictions& p = predictions_scratch_;
+  StampedPose own;
+  if (!graph_->LatestGlobalPose(graph_->robot(), &own)) return;
+  p.valid = true;
+  p.time = own.time;
+  p.T_global_body = own.T_frame_body;
+  // The others move slowly or not at all; placing them costs a pass over the graph's variables.
+  if (own.time - carriers_placed_time_ >= Duration::Seconds(1.0)) {
+    carriers_placed_time_ = own.time;
+    p.carriers.clear();
+    for (const std::string& name : robot_carriers_) {
+      const auto letter = letters_.find(name);
+      StampedPose pose;
+      if (letter == letters_.end() || !graph_->LatestGlobalPose(letter->second, &pose)) continue;
+      p.carriers.push_back({name, false, pose.time, pose.T_frame_body});
+    }
+    for (size_t i = 0; i < landmark_carriers_.size(); ++i) {
+      Eigen::Isometry3d T_global_landmark;
+      if (graph_->LandmarkGlobalPose(i, &T_global_landmark))
+        p.carriers.push_back({landmark_carriers_[i], true, own.time, T_global_landmark});
+    }
+  }
+  const std::lock_guard lock(predictions_mutex_);
+  predictions_ = p;
 }
 
 void Pipeline::TakeSightings(Timestamp before) {
@@ -616,6 +656,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       }
     }
     if (detection_ && !deterministic_) TakeSightings(Timestamp::FromNanoseconds(INT64_MAX));
+    if (worked && predict_carriers_) PublishPredictions();
     if (matching_ && !deterministic_) {
       TakeSubmaps(UINT64_MAX);
       matching_->Step(*graph_);

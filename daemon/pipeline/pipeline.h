@@ -195,6 +195,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void DetectionLoop(std::stop_token stop);
   // Graph thread: this robot's sightings up to (not including) `before` into the graph and the team.
   void TakeSightings(Timestamp before);
+  // Graph thread: where the graph places this robot and the carriers, for the detection thread.
+  void PublishPredictions();
   void GraphLoop(std::stop_token stop);
   void DrainEstimates();
   void TakeMappingInputs();
@@ -277,6 +279,14 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   int64_t detection_every_ = 1;
   uint64_t detection_counter_ = 0;  // stereo thread
   std::map<std::string, char> letters_;  // team names -> graph letters
+  // The graph's places of the tag carriers (live runs): the graph thread fills the scratch and
+  // copies it under the mutex, the detection thread copies it out before each image.
+  bool predict_carriers_ = false;
+  std::vector<std::string> robot_carriers_, landmark_carriers_;  // other robots; landmarks by index
+  CarrierPredictions predictions_scratch_;  // graph thread
+  Timestamp carriers_placed_time_;          // graph thread: data time of the last teammates' refresh
+  std::mutex predictions_mutex_;
+  CarrierPredictions predictions_;
   GraphSceneEncoder graph_scene_;       // graph thread: the live /graph view
   uint64_t graph_shown_origins_ = 0;
   Timestamp graph_shown_time_;

@@ -22,6 +22,20 @@ struct RobotDetectionOptions {
   double roi_margin = 0.5;      // of the tag's extent in the image, added on every side
   double roi_margin_px = 32.0;  // px, added on every side as well (the robots' motion in a frame)
   double track_timeout = 1.0;   // s
+  // Regions where the graph places teammates and landmarks, searched at `roi_decimate` on every
+  // image handed to the stage for carriers with no tag tracked: farther than the whole-frame scan
+  // reaches, and between its images. A carrier's place is trusted to `prediction_margin` plus
+  // `prediction_speed` for every second of its estimate's age, this robot's heading to
+  // `prediction_turn_rate` for every second of its own; regions larger than
+  // `prediction_max_area` of the image, or from estimates older than `prediction_max_age`, are left
+  // to the whole-frame scans. Live runs only: in a deterministic replay the graph's progress at a
+  // given image would depend on thread timing.
+  bool predicted_regions = true;
+  double prediction_margin = 0.5;     // m
+  double prediction_speed = 1.0;      // m/s
+  double prediction_turn_rate = 0.5;  // rad/s
+  double prediction_max_age = 10.0;   // s
+  double prediction_max_area = 0.5;   // of the image
   // Which tag is on which robot or landmark (detection/tag_carrier_table.h); "" with `source: sim`
   // takes the simulated world's.
   std::string carriers_file;
@@ -51,6 +65,12 @@ struct RobotDetectionOptions {
     v.Number("roi_margin", roi_margin, 0.0, 10.0, "tag extents");
     v.Number("roi_margin_px", roi_margin_px, 0.0, 1000.0, "px");
     v.Number("track_timeout", track_timeout, 0.0, 60.0, "s");
+    v.Flag("predicted_regions", predicted_regions);
+    v.Number("prediction_margin", prediction_margin, 0.0, 100.0, "m");
+    v.Number("prediction_speed", prediction_speed, 0.0, 100.0, "m/s");
+    v.Number("prediction_turn_rate", prediction_turn_rate, 0.0, 100.0, "rad/s");
+    v.Number("prediction_max_age", prediction_max_age, 0.0, 3600.0, "s");
+    v.Number("prediction_max_area", prediction_max_area, 0.0, 1.0, "of the image");
     v.Text("carriers_file", carriers_file);
     v.Number("corner_error", corner_error, 0.0, 10.0, "px");
     v.Text("error_model", error_model);

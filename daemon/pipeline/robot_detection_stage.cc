@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/bounded_errors.h"
 #include "common/monotonic_clock.h"
@@ -123,7 +124,80 @@ Expected<std::vector<TagDetection>> RobotDetectionStage::Find(const RectifiedPai
   return all;
 }
 
-void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSighting>* out) {
+bool RobotDetectionStage::Tracked(const std::string& carrier) const {
+  for (const auto& [id, track] : tracks_) {
+    const TagMount* mount = table_.Find(id);
+    if (mount != nullptr && mount->carrier == carrier) return true;
+  }
+  return false;
+}
+
+void RobotDetectionStage::PredictRegions(const CarrierPredictions& predictions, Timestamp time,
+                                         std::vector<PredictedRegion>* out) const {
+  if (!predictions.valid) return;
+  const double own_age = std::abs((time - predictions.time).seconds());
+  if (own_age > options_.prediction_max_age) return;
+  const Eigen::Isometry3d T_cam_global = (predictions.T_global_body * T_body_cam_).inverse();
+  const double max_area = options_.prediction_max_area * camera_.width * camera_.height;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  for (const CarrierPredictions::Carrier& c : predictions.carriers) {
+    if ((!c.landmark && c.name == robot_) || Tracked(c.name)) continue;
+    const double age = c.landmark ? 0.0 : std::abs((time - c.time).seconds());
+    if (age > options_.prediction_max_age) continue;
+    // The carrier lies within `radius` of its place; this robot's heading is off by up to `turn`.
+    const double radius = options_.prediction_margin + options_.prediction_speed * (age + own_age);
+    const double turn = std::min(options_.prediction_turn_rate * own_age, 1.0);
+    const Eigen::Isometry3d T_cam_carrier = T_cam_global * c.T_global_carrier;
+    Eigen::Vector2d lo(kInf, kInf), hi(-kInf, -kInf);
+    double nearest = kInf;
+    for (const auto& [id, mount] : table_.tags()) {
+      if (mount.carrier != c.name || mount.landmark != c.landmark) continue;
+      const Eigen::Isometry3d T_cam_tag = T_cam_carrier * mount.T_carrier_tag;
+      // Only tags that face the camera can be decoded (AprilTag's z points into the tag).
+      if (T_cam_tag.inverse().translation().z() >= 0.0) continue;
+      if (T_cam_tag.translation().norm() - radius > options_.max_distance) continue;
+      const double half = 0.5 * mount.size;
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d p = T_cam_tag * Eigen::Vector3d(k & 1 ? half : -half, k & 2 ? half : -half, 0.0);
+        nearest = std::min(nearest, p.z());
+        if (p.z() <= 0.0) continue;
+        const Eigen::Vector2d uv(camera_.fx * p.x() / p.z() + camera_.cx, camera_.fy * p.y() / p.z() + camera_.cy);
+        lo = lo.cwiseMin(uv);
+        hi = hi.cwiseMax(uv);
+      }
+    }
+    // A carrier that may be within reach of the camera could be anywhere in the image: the
+    // whole-frame scans find it.
+    if (!(nearest - radius > 0.5) || !(lo.x() <= hi.x())) continue;
+    const double margin_px =
+        camera_.fx * (radius / (nearest - radius) + std::tan(turn)) + options_.roi_margin_px;
+    const PixelBox box = Region(lo, hi, camera_.width, camera_.height, options_.roi_margin, margin_px);
+    if (box.width <= 0 || static_cast<double>(box.width) * box.height > max_area) continue;
+    out->push_back(PredictedRegion{c.name, box});
+  }
+}
+
+Status RobotDetectionStage::FindPredicted(const RectifiedPair& pair, std::vector<TagDetection>* found) {
+  for (const PredictedRegion& r : predicted_) {
+    const bool seen = std::any_of(found->begin(), found->end(), [&](const TagDetection& d) {
+      const TagMount* mount = table_.Find(d.id);
+      return mount != nullptr && mount->carrier == r.carrier;
+    });
+    if (seen) continue;
+    ++report_.predicted_regions;
+    auto more = region_detector_.Detect(pair.left, &r.box);
+    if (!more.ok()) return more.status();
+    for (TagDetection& d : *more) {
+      if (std::any_of(found->begin(), found->end(), [&](const TagDetection& a) { return a.id == d.id; })) continue;
+      found->push_back(std::move(d));
+      ++report_.tags_in_predicted_regions;
+    }
+  }
+  return Status::Ok();
+}
+
+void RobotDetectionStage::Process(const RectifiedPair& pair, const CarrierPredictions* predictions,
+                                  std::vector<TagSighting>* out) {
   const MonotonicClock clock;
   const Timestamp start = clock.Now();
   ++report_.images;
@@ -134,13 +208,21 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, std::vector<TagSigh
     const double age = (pair.time - it->second.seen).seconds();
     it = (age > options_.track_timeout || age < 0.0) ? tracks_.erase(it) : std::next(it);
   }
-  if (!full && tracks_.empty()) {
+  predicted_.clear();
+  if (predictions != nullptr && predictions->valid && options_.predicted_regions) {
+    ++report_.predictions;
+    PredictRegions(*predictions, pair.time, &predicted_);
+  }
+  if (!full && tracks_.empty() && predicted_.empty()) {
     ++report_.idle;
     return;
   }
   const auto unknown = [&] { return detector_.counts().unknown_ids + region_detector_.counts().unknown_ids; };
   const uint64_t unknown_before = unknown();
   auto found = Find(pair, full);
+  if (found.ok() && !predicted_.empty()) {
+    if (Status s = FindPredicted(pair, &*found); !s.ok()) found = s;
+  }
   report_.unknown_ids += unknown() - unknown_before;
   if (!found.ok()) {
     ++report_.bad_images;

@@ -223,6 +223,142 @@ TEST(RobotDetectionStageTest, RegionScansFollowATagBetweenWholeFrameScans) {
   EXPECT_GT(stage.region_time().count(), 0u);
 }
 
+// Where the graph would place a carrier whose tag `id` the camera sees at T_cam_tag, its place
+// moved by `offset` (global axes), with this robot at the global origin at time 0.
+CarrierPredictions PredictionOf(const TagCarrierTable& table, int id, const Eigen::Isometry3d& T_cam_tag,
+                                const Eigen::Vector3d& offset, double carrier_time) {
+  CarrierPredictions p;
+  p.valid = true;
+  p.time = Timestamp::FromNanoseconds(0);
+  const TagMount* mount = table.Find(id);
+  CarrierPredictions::Carrier c;
+  c.name = mount->carrier;
+  c.landmark = mount->landmark;
+  c.time = Timestamp::FromNanoseconds(static_cast<int64_t>(carrier_time * 1e9));
+  c.T_global_carrier = p.T_global_body * BodyCam() * T_cam_tag * mount->T_carrier_tag.inverse();
+  c.T_global_carrier.translation() += offset;
+  p.carriers.push_back(c);
+  return p;
+}
+
+// A teammate 11 m away is beyond the reach of the whole-frame scans at decimate 2; where the
+// graph places it (0.3 m off, within its margin), the stage searches at full resolution and finds
+// it, on the whole-frame scan's image and on the images between, where nothing is tracked.
+TEST(RobotDetectionStageTest, PredictedRegionsFindATeammateBeyondTheWholeFrameScansReach) {
+  RobotDetectionOptions o = DetectionOptions();
+  o.detector.decimate = 2.0;
+  o.every_nth_frame = 2;
+  o.roi_every_nth_frame = 1;
+  o.max_distance = 20.0;
+  o.track_timeout = 0.05;  // the next image searches the prediction, not the track
+  const TagCarrierTable table = Table();
+  Eigen::Isometry3d T_cam_tag = TagInView(11.0, 10 * kDeg);
+  T_cam_tag.translation().head<2>() *= 11.0 / 3.0;
+  const cv::Mat far = testing::RenderTag(10, 0.16, T_cam_tag, Pinhole());
+  ASSERT_TRUE(TagDetector(o.detector).Detect(testing::ImageOf(far))->empty());
+  const CarrierPredictions predicted = PredictionOf(table, 10, T_cam_tag, {0.2, -0.2, 0.1}, 0.0);
+
+  RobotDetectionStage blind(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  std::vector<TagSighting> out;
+  blind.Process(PairOf(far, 0), &out);            // whole
+  blind.Process(PairOf(far, 100'000'000), &out);  // between: nothing tracked, idle
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(blind.report().idle, 1u);
+
+  RobotDetectionStage stage(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  stage.Process(PairOf(far, 0), &predicted, &out);            // whole, then the prediction
+  stage.Process(PairOf(far, 100'000'000), &predicted, &out);  // between
+  ASSERT_EQ(out.size(), 2u);
+  for (const TagSighting& s : out) {
+    EXPECT_EQ(s.detection.observed, "rover2");
+    EXPECT_NEAR(s.detection.distance, T_cam_tag.translation().norm(), 0.5);
+  }
+  EXPECT_EQ(stage.report().predictions, 2u);
+  EXPECT_EQ(stage.report().predicted_regions, 2u);
+  EXPECT_EQ(stage.report().tags_in_predicted_regions, 2u);
+  EXPECT_EQ(stage.report().idle, 0u);
+  // With the tag tracked, its region is searched instead of the prediction.
+  o.track_timeout = 1.0;
+  RobotDetectionStage tracking(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  out.clear();
+  tracking.Process(PairOf(far, 0), &predicted, &out);
+  tracking.Process(PairOf(far, 100'000'000), &predicted, &out);
+  EXPECT_EQ(out.size(), 2u);
+  EXPECT_EQ(tracking.report().predicted_regions, 1u);
+  EXPECT_EQ(tracking.report().tags_in_regions, 1u);
+}
+
+TEST(RobotDetectionStageTest, PredictedRegionsCoverTheCarrierAndGrowWithTheEstimatesAge) {
+  RobotDetectionOptions o = DetectionOptions();
+  o.max_distance = 20.0;
+  const TagCarrierTable table = Table();
+  RobotDetectionStage stage(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  Eigen::Isometry3d T_cam_tag = TagInView(15.0, 0.0);
+  const Eigen::Vector2d centre(1080.0 * T_cam_tag.translation().x() / 15.0 + 512.0,
+                               1080.0 * T_cam_tag.translation().y() / 15.0 + 254.0);
+  const auto region = [&](const CarrierPredictions& p, double at) {
+    std::vector<RobotDetectionStage::PredictedRegion> r;
+    stage.PredictRegions(p, Timestamp::FromNanoseconds(static_cast<int64_t>(at * 1e9)), &r);
+    return r;
+  };
+  // Off by the margin: the tag's true place is inside.
+  const auto fresh = region(PredictionOf(table, 10, T_cam_tag, {0.0, 0.5, 0.0}, 0.0), 0.0);
+  ASSERT_EQ(fresh.size(), 1u);
+  EXPECT_EQ(fresh[0].carrier, "rover2");
+  const PixelBox& b = fresh[0].box;
+  EXPECT_TRUE(centre.x() > b.x && centre.x() < b.x + b.width && centre.y() > b.y && centre.y() < b.y + b.height);
+  // The teammate's estimate a second old: a larger region; this robot's 50 ms old: larger still.
+  const auto old = region(PredictionOf(table, 10, T_cam_tag, Eigen::Vector3d::Zero(), -1.0), 0.0);
+  const auto both = region(PredictionOf(table, 10, T_cam_tag, Eigen::Vector3d::Zero(), -1.0), 0.05);
+  ASSERT_EQ(old.size(), 1u);
+  ASSERT_EQ(both.size(), 1u);
+  EXPECT_GT(old[0].box.width, fresh[0].box.width);
+  EXPECT_GT(both[0].box.width * both[0].box.height, old[0].box.width * old[0].box.height);
+  // The lander does not move: its age is this robot's only.
+  Eigen::Isometry3d T_cam_lander_tag = TagInView(10.0, 0.0);
+  const auto lander = region(PredictionOf(table, 200, T_cam_lander_tag, Eigen::Vector3d::Zero(), -100.0), 0.0);
+  ASSERT_EQ(lander.size(), 1u);
+  EXPECT_EQ(lander[0].carrier, "lander");
+}
+
+TEST(RobotDetectionStageTest, PredictionsThatCannotHelpMakeNoRegion) {
+  RobotDetectionOptions o = DetectionOptions();
+  o.max_distance = 20.0;
+  const TagCarrierTable table = Table();
+  RobotDetectionStage stage(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  const auto count = [&](const CarrierPredictions& p, double at = 0.0) {
+    std::vector<RobotDetectionStage::PredictedRegion> r;
+    stage.PredictRegions(p, Timestamp::FromNanoseconds(static_cast<int64_t>(at * 1e9)), &r);
+    return r.size();
+  };
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  ASSERT_EQ(count(PredictionOf(table, 10, TagInView(8.0, 0.0), zero, 0.0)), 1u);
+  CarrierPredictions unplaced = PredictionOf(table, 10, TagInView(8.0, 0.0), zero, 0.0);
+  unplaced.valid = false;  // this robot not placed
+  EXPECT_EQ(count(unplaced), 0u);
+  Eigen::Isometry3d behind = TagInView(8.0, 0.0);
+  behind.translation().z() = -8.0;
+  EXPECT_EQ(count(PredictionOf(table, 10, behind, zero, 0.0)), 0u);
+  EXPECT_EQ(count(PredictionOf(table, 10, TagInView(8.0, 100 * kDeg), zero, 0.0)), 0u);  // facing away
+  EXPECT_EQ(count(PredictionOf(table, 10, TagInView(30.0, 0.0), zero, 0.0)), 0u);        // beyond max_distance
+  EXPECT_EQ(count(PredictionOf(table, 10, TagInView(0.8, 0.0), zero, 0.0)), 0u);         // within reach: anywhere
+  EXPECT_EQ(count(PredictionOf(table, 10, TagInView(8.0, 0.0), zero, -11.0)), 0u);       // older than max_age
+  EXPECT_EQ(count(PredictionOf(table, 10, TagInView(8.0, 0.0), zero, 0.0), 11.0), 0u);   // so is this robot's
+  EXPECT_EQ(count(PredictionOf(table, 10, TagInView(8.0, 0.0), zero, -5.0)), 0u);        // larger than max_area
+  EXPECT_EQ(count(PredictionOf(table, 0, TagInView(8.0, 0.0), zero, 0.0)), 1u);          // the rover: a teammate
+  RobotDetectionStage rover(o, table, ModelFor(o), Camera(), BodyCam(), "rover", 'a');
+  std::vector<RobotDetectionStage::PredictedRegion> own;
+  rover.PredictRegions(PredictionOf(table, 0, TagInView(8.0, 0.0), zero, 0.0), Timestamp::FromNanoseconds(0), &own);
+  EXPECT_TRUE(own.empty());  // its own tags
+  o.predicted_regions = false;
+  RobotDetectionStage off(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  const CarrierPredictions p = PredictionOf(table, 10, TagInView(8.0, 0.0), zero, 0.0);
+  std::vector<TagSighting> out;
+  off.Process(PairOf(cv::Mat(508, 1024, CV_8UC1, cv::Scalar(128)), 0), &p, &out);
+  EXPECT_EQ(off.report().predictions, 0u);
+  EXPECT_EQ(off.report().predicted_regions, 0u);
+}
+
 TEST(RobotDetectionStageTest, RegionsGrowByTheMarginsAndStayInsideTheImage) {
   PixelBox b = RobotDetectionStage::Region({100, 50}, {140, 70}, 1024, 508, 0.5, 10);  // extent 40: 30 px
   EXPECT_EQ(b.x, 70);

@@ -101,7 +101,8 @@ TEST(VoPipelineTest, BadAndDroppedFramesAreReportedAndTheFilterKeepsRunning) {
   EXPECT_TRUE(saw_blank);
 }
 
-// Also the graph thread and the live stream (its /graph view and the log sink) beside them.
+// Also the graph thread, the tag detector (handed the graph's places by the graph thread) and the
+// live stream (its /graph view and the log sink) beside them.
 TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   const RectifiedStereoCamera cam = testing::VoTestScene::EurocLikeCamera();
   EstimationSetup setup = RoomSetup(cam);
@@ -124,6 +125,13 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   graph.enabled = true;
   graph.pose_every = 2;
   ASSERT_TRUE(p.EnableGraph(graph).ok());
+  TagCarrierTable carriers;
+  ASSERT_TRUE(carriers.Add(3, "other", false, 0.16, Eigen::Isometry3d::Identity()).ok());
+  ASSERT_TRUE(carriers.Add(7, "lander", true, 0.32, Eigen::Isometry3d::Identity()).ok());
+  RobotDetectionOptions detection;
+  detection.enabled = true;
+  detection.error_model = "online";
+  ASSERT_TRUE(p.EnableDetection(detection, carriers, "test", "").ok());
   TelemetryStage telemetry(ExecutorOptions{}, 64, /*deterministic=*/false);
   LiveStreamOptions live;
   live.enabled = true;
@@ -172,6 +180,8 @@ TEST(VoPipelineTest, LiveMappingRunsBesideTheOdometryAndCountsWhatItDrops) {
   const GraphStageReport g = p.graph()->report();
   EXPECT_GT(g.estimates, 0u);
   EXPECT_GT(g.robot_poses, 0u);
+  ASSERT_NE(p.detection(), nullptr);
+  EXPECT_GT(p.detection()->report().predictions, 0u);  // no tag in the room: no carrier placed
   EXPECT_EQ(g.rejected_factors, 0u);
   EXPECT_EQ(g.unplaced, 0u);
   EXPECT_EQ(g.frame_switches, p.estimation_report().frame_switches);
