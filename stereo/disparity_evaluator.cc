@@ -1,6 +1,8 @@
 #include "stereo/disparity_evaluator.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <limits>
 
@@ -12,9 +14,10 @@ Expected<DisparityMetric> ParseDisparityMetric(const std::string& name) {
   if (name == "bad0.5") return DisparityMetric::kBad05;
   if (name == "bad1") return DisparityMetric::kBad1;
   if (name == "bad2") return DisparityMetric::kBad2;
+  if (name == "bad3") return DisparityMetric::kBad3;
   if (name == "bad4") return DisparityMetric::kBad4;
   if (name == "d1") return DisparityMetric::kD1;
-  return InvalidArgumentError("unknown metric '" + name + "' (bad0.5, bad1, bad2, bad4, d1)");
+  return InvalidArgumentError("unknown metric '" + name + "' (bad0.5, bad1, bad2, bad3, bad4, d1)");
 }
 
 const char* DisparityMetricName(DisparityMetric metric) {
@@ -22,6 +25,7 @@ const char* DisparityMetricName(DisparityMetric metric) {
     case DisparityMetric::kBad05: return "bad0.5";
     case DisparityMetric::kBad1: return "bad1";
     case DisparityMetric::kBad2: return "bad2";
+    case DisparityMetric::kBad3: return "bad3";
     case DisparityMetric::kBad4: return "bad4";
     case DisparityMetric::kD1: return "d1";
   }
@@ -86,6 +90,41 @@ FloatImage DisparityEvaluator::DeriveNonOccludedMask(const FloatImage& truth) {
   return mask;
 }
 
+FloatImage DisparityEvaluator::InterpolateBackground(const FloatImage& estimate) {
+  FloatImage out = estimate;
+  const int w = out.width, h = out.height;
+  const auto at = [&](int x, int y) -> float& { return out.data[static_cast<size_t>(y) * w + x]; };
+  std::vector<bool> row_has(static_cast<size_t>(h), false);
+  for (int y = 0; y < h; ++y) {
+    int last = -1;  // the last column with an estimate
+    for (int x = 0; x < w; ++x) {
+      if (!std::isfinite(at(x, y))) continue;
+      if (last < 0) {
+        for (int k = 0; k < x; ++k) at(k, y) = at(x, y);  // the row's start
+      } else if (x > last + 1) {
+        const float fill = std::min(at(last, y), at(x, y));  // the background side of the gap
+        for (int k = last + 1; k < x; ++k) at(k, y) = fill;
+      }
+      last = x;
+    }
+    if (last < 0) continue;
+    for (int k = last + 1; k < w; ++k) at(k, y) = at(last, y);  // the row's end
+    row_has[static_cast<size_t>(y)] = true;
+  }
+  // Rows above the first row with an estimate take that row, rows below the last take the last
+  // (rows without any estimate between two that have some stay missing, as in KITTI's devkit).
+  const auto first = std::find(row_has.begin(), row_has.end(), true);
+  if (first == row_has.end()) return out;
+  const int top = static_cast<int>(first - row_has.begin());
+  const int bottom = h - 1 - static_cast<int>(std::find(row_has.rbegin(), row_has.rend(), true) - row_has.rbegin());
+  for (int y = 0; y < h; ++y) {
+    if (y >= top && y <= bottom) continue;
+    const int from = y < top ? top : bottom;
+    std::copy_n(out.data.begin() + static_cast<ptrdiff_t>(from) * w, w, out.data.begin() + static_cast<ptrdiff_t>(y) * w);
+  }
+  return out;
+}
+
 Expected<DisparityScore> DisparityEvaluator::Score(const FloatImage& estimate,
                                                    const FloatImage& truth, const FloatImage& mask,
                                                    DisparityMetric metric) {
@@ -109,6 +148,7 @@ Expected<DisparityScore> DisparityEvaluator::Score(const FloatImage& estimate,
     case DisparityMetric::kBad05: threshold = 0.5; break;
     case DisparityMetric::kBad1: threshold = 1.0; break;
     case DisparityMetric::kBad2: threshold = 2.0; break;
+    case DisparityMetric::kBad3: threshold = 3.0; break;
     case DisparityMetric::kBad4: threshold = 4.0; break;
     case DisparityMetric::kD1: threshold = 3.0; break;
   }

@@ -1,7 +1,8 @@
 #pragma once
 // Scores a disparity map against ground truth the way the Middlebury and KITTI benchmarks do:
 // a pixel with ground truth is bad when its estimate is missing or off by more than the threshold
-// (KITTI D1: more than 3 px and more than 5 % of the true disparity).
+// (KITTI 2012: bad3; KITTI 2015's D1: more than 3 px and more than 5 % of the true disparity).
+// KITTI also scores after filling the estimate's holes from the background (InterpolateBackground).
 
 #include <string>
 
@@ -10,7 +11,7 @@
 
 namespace cairn {
 
-enum class DisparityMetric { kBad05, kBad1, kBad2, kBad4, kD1 };
+enum class DisparityMetric { kBad05, kBad1, kBad2, kBad3, kBad4, kD1 };
 
 Expected<DisparityMetric> ParseDisparityMetric(const std::string& name);
 const char* DisparityMetricName(DisparityMetric metric);
@@ -36,6 +37,11 @@ class DisparityEvaluator {
   static Expected<DisparityScore> Score(const FloatImage& estimate, const FloatImage& truth,
                                         const FloatImage& mask, DisparityMetric metric);
   static FloatImage DeriveNonOccludedMask(const FloatImage& truth);
+  // KITTI's way of scoring a sparse estimate as if dense: in each row, a run of missing pixels
+  // between two estimates takes the smaller (farther) of the two and the ends of the row take its
+  // nearest estimate; rows above the first row with an estimate copy it, rows below the last copy
+  // that one. Rows without any estimate between those stay missing.
+  static FloatImage InterpolateBackground(const FloatImage& estimate);
 };
 
 // Reads a Middlebury mask PNG (255 non-occluded, 128 occluded, 0 unknown) into a FloatImage.

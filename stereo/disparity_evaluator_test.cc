@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -87,8 +88,42 @@ TEST(DisparityEvaluatorTest, RejectsSizeMismatchAndUnknownMetric) {
   FloatImage a{2, 2, {1, 1, 1, 1}}, b{2, 1, {1, 1}};
   EXPECT_FALSE(DisparityEvaluator::Score(a, b, FloatImage{}, DisparityMetric::kBad1).ok());
   EXPECT_FALSE(DisparityEvaluator::Score(a, a, b, DisparityMetric::kBad1).ok());
-  EXPECT_FALSE(ParseDisparityMetric("bad3").ok());
+  EXPECT_FALSE(ParseDisparityMetric("bad5").ok());
   EXPECT_TRUE(ParseDisparityMetric("d1").ok());
+}
+
+// KITTI's background interpolation: gaps between estimates take the farther one, the ends of a
+// row its nearest, rows above the first and below the last row with estimates copy those; empty
+// rows between stay missing.
+TEST(DisparityEvaluatorTest, InterpolatesFromTheBackgroundAsKittiDoes) {
+  const FloatImage est{6, 5, {kInf, kInf, kInf, kInf, kInf, kInf,   //
+                              kInf, 9.0f, kInf, kInf, 4.0f, kInf,     //
+                              kInf, kInf, kInf, kInf, kInf, kInf,     //
+                              2.0f, kInf, 7.0f, 8.0f, kInf, kInf,     //
+                              kInf, kInf, kInf, kInf, kInf, kInf}};
+  const FloatImage out = DisparityEvaluator::InterpolateBackground(est);
+  const std::vector<float> row1 = {9, 9, 4, 4, 4, 4}, row3 = {2, 2, 7, 8, 8, 8};
+  for (int x = 0; x < 6; ++x) {
+    EXPECT_EQ(out.at(x, 0), row1[static_cast<size_t>(x)]) << x;  // copies the first row with estimates
+    EXPECT_EQ(out.at(x, 1), row1[static_cast<size_t>(x)]) << x;
+    EXPECT_FALSE(std::isfinite(out.at(x, 2))) << x;               // between two rows: stays missing
+    EXPECT_EQ(out.at(x, 3), row3[static_cast<size_t>(x)]) << x;
+    EXPECT_EQ(out.at(x, 4), row3[static_cast<size_t>(x)]) << x;   // copies the last
+  }
+  const FloatImage none{3, 2, std::vector<float>(6, kInf)};
+  for (float v : DisparityEvaluator::InterpolateBackground(none).data) EXPECT_FALSE(std::isfinite(v));
+  // Scored after filling: the missing pixel next to a far estimate is right when it is background.
+  const FloatImage truth{4, 1, {2.0f, 2.0f, 2.0f, 10.0f}};
+  const FloatImage sparse{4, 1, {2.0f, kInf, kInf, 10.0f}};
+  const FloatImage all{4, 1, std::vector<float>(4, 255.0f)};
+  auto raw = DisparityEvaluator::Score(sparse, truth, all, DisparityMetric::kBad3);
+  auto filled = DisparityEvaluator::Score(DisparityEvaluator::InterpolateBackground(sparse), truth, all,
+                                          DisparityMetric::kBad3);
+  ASSERT_TRUE(raw.ok() && filled.ok());
+  EXPECT_DOUBLE_EQ(raw->bad_all, 0.5);
+  EXPECT_DOUBLE_EQ(filled->bad_all, 0.0);
+  EXPECT_EQ(*ParseDisparityMetric("bad3"), DisparityMetric::kBad3);
+  EXPECT_STREQ(DisparityMetricName(DisparityMetric::kBad3), "bad3");
 }
 
 TEST(DisparityEvaluatorTest, DerivedMaskMarksPixelsHiddenBehindNearerOnes) {

@@ -264,7 +264,9 @@ int RunStereo(const CommandArgs& args) {
 int RunStereoEval(const CommandArgs& args) {
   const char* usage =
       "usage: cairn stereo-eval --est DISP.pfm --gt GT [--gt-scale S] [--mask MASK] "
-      "[--metric bad0.5|bad1|bad2|bad4|d1]\n";
+      "[--metric bad0.5|bad1|bad2|bad3|bad4|d1]\n"
+      "  Missing estimates count as bad; the *_interpolated scores first fill them from the background\n"
+      "  as KITTI's devkit does.\n";
   if (WantsHelp(args)) return PrintUsage(usage);
   const ArgMap a(args, {"--est", "--gt", "--gt-scale", "--mask", "--metric"}, {});
   if (!a.error.empty() || !a.positional.empty() || a.Get("--est").empty() || a.Get("--gt").empty()) {
@@ -288,11 +290,14 @@ int RunStereoEval(const CommandArgs& args) {
   }
   auto score = DisparityEvaluator::Score(*est, *gt, mask, *metric);
   if (!score.ok()) return Fail(score.status());
+  auto filled = DisparityEvaluator::Score(DisparityEvaluator::InterpolateBackground(*est), *gt, mask, *metric);
+  if (!filled.ok()) return Fail(filled.status());
   std::printf(
-      "{\"metric\": \"%s\", \"bad_nonocc\": %.6f, \"bad_all\": %.6f, \"density\": %.6f, "
+      "{\"metric\": \"%s\", \"bad_nonocc\": %.6f, \"bad_all\": %.6f, \"bad_nonocc_interpolated\": %.6f, "
+      "\"bad_all_interpolated\": %.6f, \"density\": %.6f, "
       "\"scored_nonocc\": %ld, \"scored_all\": %ld, \"nonocc_mask\": \"%s\"}\n",
-      DisparityMetricName(*metric), score->bad_nonocc, score->bad_all, score->density,
-      score->scored_nonocc, score->scored_all, score->mask_derived ? "derived" : "file");
+      DisparityMetricName(*metric), score->bad_nonocc, score->bad_all, filled->bad_nonocc, filled->bad_all,
+      score->density, score->scored_nonocc, score->scored_all, score->mask_derived ? "derived" : "file");
   return 0;
 }
 
