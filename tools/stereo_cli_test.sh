@@ -26,6 +26,8 @@ expect_ok "$C" stereo "$D/im2.png" "$D/im6.png" --max-disparity 64 --out "$T/con
 [ -s "$T/cones.pfm" ] && [ -s "$T/cones.png" ] || { echo "FAIL: no output files"; exit 1; }
 expect_ok "$C" stereo-eval --est "$T/cones.pfm" --gt "$D/disp2.png" --gt-scale 4 --metric bad1
 grep -q '"bad_nonocc"' "$T/out" && grep -q '"density"' "$T/out" && grep -q '"scored_all"' "$T/out" || { echo "FAIL: JSON"; cat "$T/out"; exit 1; }
+expect_ok "$C" stereo-eval --est "$T/cones.pfm" --gt "$D/disp2.png" --gt-scale 4 --metric bad3
+grep -q '"metric": "bad3"' "$T/out" && grep -q '"bad_nonocc_interpolated"' "$T/out" || { echo "FAIL: JSON"; cat "$T/out"; exit 1; }
 expect_ok "$C" stereo "$M/im0.png" "$M/im1.png" --max-disparity 96 --min-disparity 0 --paths 8 --out "$T/moto.pfm"
 expect_ok "$C" stereo-eval --est "$T/moto.pfm" --gt "$M/disp0GT.pfm" --mask "$M/mask0nocc.png" --metric bad0.5
 expect_ok "$C" bench stereo --left "$M/im0.png" --right "$M/im1.png" --size 160x96 --max-disparity 32 --iterations 1
@@ -54,7 +56,7 @@ expect_fail "$C" stereo "$D/im2.png" "$D/im6.png" --max-disparity 64 --bogus 1 -
 expect_fail "$C" stereo-eval --est "$T/missing.pfm" --gt "$D/disp2.png"
 expect_fail "$C" stereo-eval --est "$T/cones.pfm" --gt "$D/missing.png"
 expect_fail "$C" stereo-eval --est "$T/cones.pfm" --gt "$M/disp0GT.pfm"
-expect_fail "$C" stereo-eval --est "$T/cones.pfm" --gt "$D/disp2.png" --metric bad3
+expect_fail "$C" stereo-eval --est "$T/cones.pfm" --gt "$D/disp2.png" --metric bad5
 expect_fail "$C" stereo-eval --est "$D/im2.png" --gt "$D/disp2.png"
 expect_fail "$C" bench stereo --left "$M/im0.png" --right "$M/im1.png" --size 10x10
 expect_fail "$C" bench stereo --left "$M/missing.png" --right "$M/im1.png"
