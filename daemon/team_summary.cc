@@ -63,6 +63,8 @@ std::string BuildTeamJson(const TeamReport& r, const TeamFile& team, const Graph
     j.Field("items_received", p.items_received);
     j.Field("duplicates", p.duplicates);
     j.Field("resends", p.resends);
+    j.Field("skipped_items", p.skipped_items);
+    j.Field("resumed_bytes", p.resumed_bytes);
     j.Field("refused_messages", p.refused_messages);
     j.Field("refused_fragments", p.refused_fragments);
     j.Field("implausible_marks", p.implausible_marks);

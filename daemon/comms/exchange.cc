@@ -21,6 +21,14 @@ constexpr int64_t kRetryMilliseconds = 50;
 constexpr double kGoneSummaries = 5.0;
 // Settled must hold this many summary intervals: a teammate's change of mind arrives within one.
 constexpr double kStableSummaries = 3.0;
+// Each resend of a lane while the peer is not heard doubles its timeout, up to 2^this. When the
+// acknowledgements do not come back (the return link is down), going back to the first unheld
+// item every timeout fills the slow forward link with copies, and the items behind them never
+// get through.
+constexpr int kMaxResendDoublings = 3;
+// Items per lane a summary lists as held beyond the mark, and in pieces (bounds a summary's size
+// and what a peer's summary can make this robot keep).
+constexpr int kMaxAhead = 64;
 
 uint32_t CrcOf(const std::string& bytes) {
   return Crc32::Of(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
@@ -30,7 +38,11 @@ uint32_t CrcOf(const std::string& bytes) {
 
 Exchange::Exchange(std::string self, std::vector<std::string> peers, ItemStore& store,
                    const ExchangeOptions& options, ItemSink sink)
-    : self_(std::move(self)), store_(store), options_(options), sink_(std::move(sink)) {
+    : self_(std::move(self)),
+      store_(store),
+      options_(options),
+      sink_(std::move(sink)),
+      assembler_(static_cast<uint64_t>(options.reorder_bytes)) {
   for (std::string& name : peers) {
     Peer& p = peers_[name];
     p.stats.name = name;
@@ -134,7 +146,10 @@ void Exchange::OnSummary(Peer& peer, const std::string& name, const void* summar
       peer.partial.erase(lane);
     }
     peer.marks[lane] = mark;
-    if (advanced) peer.progress[lane] = now;
+    if (advanced) {
+      peer.progress[lane] = now;
+      peer.resends.erase(lane);
+    }
     auto& sent = peer.sent_at[lane];
     sent.erase(sent.begin(), sent.upper_bound(mark));
     auto next = peer.next.find(lane);
@@ -153,6 +168,75 @@ void Exchange::OnSummary(Peer& peer, const std::string& name, const void* summar
     }
     (void)hwm;
   }
+  OnAhead(peer, name, summary_ptr);
+}
+
+void Exchange::OnAhead(Peer& peer, const std::string& name, const void* summary_ptr) {
+  const auto& summary = *static_cast<const exchange::Summary*>(summary_ptr);
+  peer.held_ahead.clear();
+  peer.held_prefix.clear();
+  for (const exchange::LaneAhead& a : summary.ahead()) {
+    if (!ValidOrigin(a.origin()) || a.lane() >= kExchangeLanes || a.partial_seq_size() != a.partial_bytes_size()) {
+      ++peer.stats.refused_fragments;
+      stats_.last_error = "a summary from " + name + " says what it holds ahead of lane " + std::to_string(a.lane()) +
+                          " of origin '" + a.origin().substr(0, 40) + "' inconsistently";
+      continue;
+    }
+    const LaneId lane{a.origin(), static_cast<uint8_t>(a.lane())};
+    const auto m = peer.marks.find(lane);
+    const uint64_t mark = m == peer.marks.end() ? 0 : m->second;
+    auto& held = peer.held_ahead[lane];
+    for (int i = 0; i < std::min(a.held_size(), kMaxAhead); ++i) {
+      if (a.held(i) > mark) held.insert(a.held(i));
+    }
+    auto& prefix = peer.held_prefix[lane];
+    for (int i = 0; i < std::min(a.partial_seq_size(), kMaxAhead); ++i) {
+      if (a.partial_seq(i) > mark && a.partial_bytes(i) > 0) prefix[a.partial_seq(i)] = a.partial_bytes(i);
+    }
+  }
+}
+
+void Exchange::DescribeAhead(void* summary_ptr) const {
+  auto& summary = *static_cast<exchange::Summary*>(summary_ptr);
+  std::map<LaneId, exchange::LaneAhead*> lanes;
+  const auto entry = [&](const LaneId& lane) {
+    exchange::LaneAhead*& a = lanes[lane];
+    if (a == nullptr) {
+      a = summary.add_ahead();
+      a->set_origin(lane.first);
+      a->set_lane(lane.second);
+    }
+    return a;
+  };
+  for (const auto& [lane, items] : reorder_) {
+    exchange::LaneAhead* a = entry(lane);
+    for (const auto& [seq, item] : items) {
+      if (a->held_size() >= kMaxAhead) break;
+      a->add_held(seq);
+    }
+  }
+  for (const auto& [key, covered] : assembler_.Prefixes()) {
+    exchange::LaneAhead* a = entry({std::get<0>(key), std::get<1>(key)});
+    if (a->partial_seq_size() >= kMaxAhead) continue;
+    a->add_partial_seq(std::get<2>(key));
+    a->add_partial_bytes(static_cast<uint32_t>(covered));
+  }
+}
+
+bool Exchange::HeldAhead(const Peer& peer, const LaneId& lane, uint64_t seq) {
+  const auto held = peer.held_ahead.find(lane);
+  return held != peer.held_ahead.end() && held->second.count(seq) != 0;
+}
+
+void Exchange::SkipHeld(Peer& peer) {
+  for (auto& [lane, next] : peer.next) {
+    if (peer.partial.count(lane) != 0) continue;
+    const uint64_t hwm = store_.HighWaterMark(lane.first, lane.second);
+    while (next <= hwm && HeldAhead(peer, lane, next)) {
+      ++next;
+      ++peer.stats.skipped_items;
+    }
+  }
 }
 
 void Exchange::PeerHolds(Peer& peer, const LaneId& lane, uint64_t seq, Timestamp now) {
@@ -163,6 +247,7 @@ void Exchange::PeerHolds(Peer& peer, const LaneId& lane, uint64_t seq, Timestamp
   if (seq <= mark) return;
   mark = seq;
   peer.progress[lane] = now;
+  peer.resends.erase(lane);
   auto& sent = peer.sent_at[lane];
   sent.erase(sent.begin(), sent.upper_bound(mark));
   uint64_t& next = peer.next[lane];
@@ -203,50 +288,16 @@ void Exchange::OnFragment(Peer& peer, const void* fragment_ptr, Timestamp now) {
     if (f.offset() == 0) ++peer.stats.duplicates;
     return;
   }
-  const auto key = std::make_tuple(f.origin(), static_cast<uint8_t>(f.lane()), f.seq());
-  auto partial = partials_.find(key);
-  if (partial != partials_.end() && (partial->second.kind != f.kind() || partial->second.crc != f.payload_crc32() ||
-                                     partial->second.total != total)) {
-    // Two versions of one item: one sender is wrong; start again with the newer pieces.
-    ++peer.stats.refused_fragments;
-    partial_bytes_ -= partial->second.bytes;
-    partials_.erase(partial);
-    partial = partials_.end();
-  }
-  if (partial == partials_.end()) {
-    if (partial_bytes_ + f.data().size() > static_cast<uint64_t>(options_.reorder_bytes)) {
-      ++stats_.reorder_dropped;
-      return;
-    }
-    Partial p;
-    p.kind = static_cast<uint16_t>(f.kind());
-    p.crc = f.payload_crc32();
-    p.total = static_cast<uint32_t>(total);
-    partial = partials_.emplace(key, std::move(p)).first;
-  }
-  Partial& p = partial->second;
-  // Pieces are kept whatever their order (a lost one comes with the next round); repeats are free.
-  if (p.pieces.count(f.offset()) == 0) {
-    p.pieces.emplace(f.offset(), f.data());
-    p.bytes += f.data().size();
-    partial_bytes_ += f.data().size();
-  }
-  uint64_t covered = 0;
-  for (const auto& [offset, data] : p.pieces) {
-    if (offset > covered) break;
-    covered = std::max<uint64_t>(covered, offset + data.size());
-  }
-  if (covered < total) return;
-  std::string payload;
-  payload.reserve(total);
-  for (const auto& [offset, data] : p.pieces) {
-    if (offset + data.size() <= payload.size()) continue;
-    payload.append(data, payload.size() - offset, std::string::npos);
-  }
-  partial_bytes_ -= p.bytes;
-  const uint16_t kind = p.kind;
-  const uint32_t crc = p.crc;
-  partials_.erase(partial);
+  const std::string& data = f.data();
+  ItemAssembler::Outcome got = assembler_.Add(
+      {f.origin(), static_cast<uint8_t>(f.lane()), f.seq()},
+      {static_cast<uint16_t>(f.kind()), f.payload_crc32(), static_cast<uint32_t>(total), f.offset(), &data});
+  if (got.conflict) ++peer.stats.refused_fragments;
+  if (got.full) ++stats_.reorder_dropped;
+  if (!got.complete) return;
+  std::string payload = std::move(got.payload);
+  const uint16_t kind = got.kind;
+  const uint32_t crc = got.crc;
   if (CrcOf(payload) != crc) {
     ++peer.stats.refused_fragments;
     stats_.last_error = "item " + f.origin() + "/" + std::to_string(f.lane()) + "/" + std::to_string(f.seq()) +
@@ -357,14 +408,20 @@ void Exchange::PumpPeer(const std::string& name, Peer& peer, Timestamp now, cons
     auto& sent = peer.sent_at[lane];
     const auto first = sent.find(mark + 1);
     const Timestamp since = first != sent.end() ? first->second : peer.progress[lane];
-    if (now - since > Duration::Seconds(options_.resend_timeout)) {
+    // Heard from since: the link works both ways and what was sent is lost; the plain timeout.
+    const bool heard = peer.stats.heard && peer.stats.last_contact > since;
+    int& resends = peer.resends[lane];
+    const int doublings = heard ? 0 : std::min(resends, kMaxResendDoublings);
+    if (now - since > Duration::Seconds(options_.resend_timeout * (1 << doublings))) {
       next = mark + 1;
       peer.partial.erase(lane);
       sent.clear();
       peer.progress[lane] = now;
+      resends = heard ? 0 : resends + 1;
       ++peer.stats.resends;
     }
   }
+  SkipHeld(peer);
   if (now >= peer.next_summary) peer.summary_due = true;
   if (now < peer.retry_at) return;
   while (peer.bucket->Ready(now)) {
@@ -381,12 +438,14 @@ void Exchange::PumpPeer(const std::string& name, Peer& peer, Timestamp now, cons
         m->set_lane(id.second);
         m->set_high_water_mark(hwm);
       }
+      DescribeAhead(summary);
     }
     // Items only to a peer that said what it holds; planned on copies, committed once sent.
     std::map<LaneId, uint64_t> next = peer.next;
     std::map<LaneId, uint32_t> partial = peer.partial;
     std::vector<std::pair<LaneId, uint64_t>> completed;
     uint64_t whole_items = 0;
+    uint64_t resumed = 0, skipped = 0;
     if (peer.stats.heard) {
       for (const LaneId& lane : SendOrder(peer)) {
         const uint64_t hwm = store_.HighWaterMark(lane.first, lane.second);
@@ -394,6 +453,11 @@ void Exchange::PumpPeer(const std::string& name, Peer& peer, Timestamp now, cons
         const uint64_t limit = lane.first == self_ ? UINT64_MAX : RelayLimit(lane, now);
         uint64_t& seq = next[lane];
         while (seq <= hwm && seq < limit && envelope.ByteSizeLong() < static_cast<size_t>(options_.message_bytes)) {
+          if (partial.count(lane) == 0 && HeldAhead(peer, lane, seq)) {
+            ++seq;
+            ++skipped;
+            continue;
+          }
           const ItemKey key{lane.first, lane.second, seq};
           if (!(cached_key_.origin == key.origin && cached_key_.lane == key.lane && cached_key_.seq == key.seq)) {
             auto item = store_.Read(key);
@@ -407,9 +471,20 @@ void Exchange::PumpPeer(const std::string& name, Peer& peer, Timestamp now, cons
             cached_kind_ = item->kind;
             cached_crc_ = CrcOf(cached_payload_);
           }
-          const auto part = partial.find(lane);
-          const uint32_t offset = part == partial.end() ? 0 : part->second;
           const size_t size = cached_payload_.size();
+          const auto part = partial.find(lane);
+          uint32_t offset = part == partial.end() ? 0 : part->second;
+          if (part == partial.end()) {
+            // A resend resumes where the peer's pieces end.
+            const auto prefix = peer.held_prefix.find(lane);
+            if (prefix != peer.held_prefix.end()) {
+              const auto bytes = prefix->second.find(seq);
+              if (bytes != prefix->second.end() && bytes->second < size) {
+                offset = bytes->second;
+                resumed += offset;
+              }
+            }
+          }
           const size_t chunk = std::min<size_t>(size - offset, static_cast<size_t>(options_.fragment_bytes));
           auto* f = envelope.add_fragments();
           f->set_origin(lane.first);
@@ -445,6 +520,8 @@ void Exchange::PumpPeer(const std::string& name, Peer& peer, Timestamp now, cons
     peer.stats.sent_bytes += size;
     ++peer.stats.sent_messages;
     peer.stats.items_sent += whole_items;
+    peer.stats.resumed_bytes += resumed;
+    peer.stats.skipped_items += skipped;
     peer.next = std::move(next);
     peer.partial = std::move(partial);
     for (const auto& [lane, seq] : completed) peer.sent_at[lane][seq] = now;

@@ -22,6 +22,7 @@
 #include "common/status.h"
 #include "common/timestamp.h"
 #include "daemon/comms/exchange_options.h"
+#include "daemon/comms/item_assembler.h"
 #include "daemon/comms/item_store.h"
 #include "daemon/comms/token_bucket.h"
 
@@ -40,6 +41,8 @@ struct ExchangePeerStats {
   uint64_t items_received = 0;    // new items from this peer, stored
   uint64_t duplicates = 0;        // items this robot held already
   uint64_t resends = 0;           // times a lane was sent again after the timeout
+  uint64_t skipped_items = 0;     // not sent again: the peer said it held them already
+  uint64_t resumed_bytes = 0;     // first bytes of items in pieces not sent again, likewise
   uint64_t refused_messages = 0;  // malformed, wrong version, or not decodable
   uint64_t refused_fragments = 0; // inconsistent or impossible fragments (bad lane, size, CRC)
   uint64_t implausible_marks = 0; // announcements of this robot's own items it never made
@@ -103,6 +106,11 @@ class Exchange {
     std::map<LaneId, uint64_t> next;       // next seq to send
     std::map<LaneId, Timestamp> progress;  // when the peer's mark last moved (or we last resent)
     std::map<LaneId, std::map<uint64_t, Timestamp>> sent_at;  // unacknowledged items: when sent
+    std::map<LaneId, int> resends;  // in a row, the peer unheard since the one before
+    // What the peer's last summary said it holds beyond its marks: whole items, and the first
+    // bytes of items in pieces.
+    std::map<LaneId, std::set<uint64_t>> held_ahead;
+    std::map<LaneId, std::map<uint64_t, uint32_t>> held_prefix;
     // Lanes whose item next[lane] is part sent: the offset of its next piece. Kept per lane so
     // that large items of several origins in turn each make progress.
     std::map<LaneId, uint32_t> partial;
@@ -113,17 +121,15 @@ class Exchange {
     Timestamp retry_at;              // the transport refused: not before then
     size_t round_robin = 0;
   };
-  struct Partial {  // an item being reassembled: pieces by offset, from any round or peer
-    uint16_t kind = 0;
-    uint32_t crc = 0;
-    uint32_t total = 0;
-    std::map<uint32_t, std::string> pieces;
-    uint64_t bytes = 0;
-  };
-
   bool SettledNow(Timestamp now) const;
   void OnSummary(Peer& peer, const std::string& name, const void* summary, Timestamp now);
   void OnFragment(Peer& peer, const void* fragment, Timestamp now);
+  // Adds to a summary what this robot holds beyond its marks (reorder buffer, items in pieces).
+  void DescribeAhead(void* summary) const;
+  void OnAhead(Peer& peer, const std::string& name, const void* summary);
+  static bool HeldAhead(const Peer& peer, const LaneId& lane, uint64_t seq);
+  // Moves the peer's next items past those it holds already.
+  void SkipHeld(Peer& peer);
   void Accept(Peer& from, StoreItem item);
   bool StoreNext(StoreItem item);
   // The first seq of `lane` not yet to be relayed (past the hwm when all may go).
@@ -140,13 +146,12 @@ class Exchange {
   ExchangeOptions options_;
   ItemSink sink_;
   std::map<std::string, Peer> peers_;
-  std::map<std::tuple<std::string, uint8_t, uint64_t>, Partial> partials_;
+  ItemAssembler assembler_;
   std::map<LaneId, std::map<uint64_t, StoreItem>> reorder_;
   // When teammates' items arrived, within the last relay_delay (older ones relay at once).
   std::map<LaneId, std::map<uint64_t, Timestamp>> arrived_;
   Timestamp now_;  // of the call in progress
   uint64_t reorder_bytes_ = 0;
-  uint64_t partial_bytes_ = 0;
   bool finished_ = false;
   std::optional<Timestamp> settled_since_;
   uint64_t store_version_ = 1;  // counts the store's appends, so summaries know if they are current

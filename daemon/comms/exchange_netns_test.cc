@@ -200,7 +200,9 @@ TEST(ExchangeNetnsTest, EveryItemCrossesA30PercentLossyLinkOnce) {
   ASSERT_EQ(b.error, "");
   for (RobotRun* r : {&a, &b}) {
     SCOPED_TRACE(r->name);
-    EXPECT_TRUE(r->settled);
+    EXPECT_TRUE(r->settled) << "resends " << r->stats.resends << ", skipped " << r->stats.skipped_items << ", resumed "
+                            << r->stats.resumed_bytes << " B, transport busy " << r->stats.transport_busy
+                            << ", messages sent " << r->stats.sent_messages << ", received " << r->stats.received_messages;
     EXPECT_EQ(r->marks[std::make_pair(std::string("a"), uint8_t{0})], 120u);
     EXPECT_EQ(r->marks[std::make_pair(std::string("a"), uint8_t{1})], 4u);
     EXPECT_EQ(r->marks[std::make_pair(std::string("b"), uint8_t{0})], 60u);

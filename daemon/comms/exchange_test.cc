@@ -170,6 +170,73 @@ TEST(ExchangeTest, ConstraintsOvertakeASubmapBacklog) {
   EXPECT_GT((submaps_arrived - published).seconds(), 10.0);
 }
 
+// Acknowledgements that do not come back (the return link is down) must not fill the forward
+// link with copies: each resend without progress waits twice as long as the one before.
+TEST(ExchangeTest, ResendsBackOffWhileTheReturnLinkIsDown) {
+  ExchangeOptions options;
+  options.link_bytes_per_s = 200000;  // more than the link carries
+  options.resend_timeout = 3.0;
+  LinkProfile profile;
+  profile.bytes_per_s = 50000;
+  Team team({"a", "b"}, {{"a", "b"}}, profile, options);
+  // Both hear each other and agree on the lane first, then b's summaries are lost for a minute.
+  ASSERT_TRUE(team.robot("a").exchange->Publish(1, 9, Payload("a", 1, 1, 100)).ok());
+  for (int i = 0; i < 300; ++i) team.Step(Duration::Milliseconds(10));
+  ASSERT_EQ(team.robot("a").exchange->PeerStats()[0].queued_items, 0u);
+  LinkProfile back = profile;
+  back.seed = 99;
+  back.outages.emplace_back(team.now(), team.now() + Duration::Seconds(60.0));
+  team.link("b", "a") = LinkEmulator(back);
+  for (uint64_t i = 2; i <= 5; ++i) ASSERT_TRUE(team.robot("a").exchange->Publish(1, 9, Payload("a", 1, i, 40000)).ok());
+  for (int i = 0; i < 6000; ++i) team.Step(Duration::Milliseconds(10));
+  EXPECT_EQ(team.robot("b").store->HighWaterMark("a", 1), 5u);
+  // The 160 KB went once and were resent after 3, 9, 21 and 45 s (timeouts 3, 6, 12, 24 s);
+  // without the back-off, every 3 s: 20 times.
+  const auto stats = team.robot("a").exchange->PeerStats()[0];
+  EXPECT_EQ(stats.resends, 4u);
+  EXPECT_LE(stats.items_sent, 1u + 5u * 4u);
+  EXPECT_LT(team.link("a", "b").counters().bytes, 5u * 4u * 42000u);
+  // Heard again: the first summary acknowledges everything, and the peer settles.
+  for (int i = 0; i < 500 && !team.Converged(); ++i) team.Step(Duration::Milliseconds(10));
+  for (int i = 0; i < 300; ++i) team.Step(Duration::Milliseconds(10));
+  EXPECT_EQ(team.robot("a").exchange->PeerStats()[0].queued_items, 0u);
+  EXPECT_EQ(team.robot("a").exchange->PeerStats()[0].resends, 4u);
+}
+
+// A resend goes back to the first item the peer lacks, but not over what the peer holds already
+// beyond it: whole items waiting for that one, and the first pieces of the items in pieces.
+TEST(ExchangeTest, ResendsSkipWhatThePeerHoldsAhead) {
+  // 800 KB through a link that loses one message in five, on five seeds: 7.6 MB sent in all,
+  // where resending everything after a lost piece took 10.6 MB. On 30 seeds, delivery took 18.0 s
+  // (median; at most 24.0 s) instead of 25.0 s (33.4 s).
+  uint64_t sent = 0, skipped = 0, resumed = 0;
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    SCOPED_TRACE(seed);
+    ExchangeOptions options;
+    options.resend_timeout = 3.0;
+    options.link_bytes_per_s = 100000;
+    LinkProfile profile;
+    profile.bytes_per_s = 100000;
+    profile.delay = Duration::Milliseconds(100);
+    profile.loss = 0.2;
+    profile.seed = seed;
+    Team team({"a", "b"}, {{"a", "b"}}, profile, options);
+    for (uint64_t i = 1; i <= 8; ++i) {
+      ASSERT_TRUE(team.robot("a").exchange->Publish(1, 9, Payload("a", 1, i, 100000)).ok());
+    }
+    for (int i = 0; i < 12000 && !team.Converged(); ++i) team.Step(Duration::Milliseconds(10));
+    ASSERT_TRUE(team.Converged());
+    for (uint64_t i = 1; i <= 8; ++i) EXPECT_EQ(team.robot("b").payloads.at({"a", 1, i}), Payload("a", 1, i, 100000));
+    const auto stats = team.robot("a").exchange->PeerStats()[0];
+    sent += stats.sent_bytes;
+    skipped += stats.skipped_items;
+    resumed += stats.resumed_bytes;
+  }
+  EXPECT_GT(skipped, 0u);
+  EXPECT_GT(resumed, 0u);
+  EXPECT_LT(sent, 9000000u);
+}
+
 // What a broken or lying teammate sends: every message refused or clamped, counted, and the
 // exchange still delivers the honest items afterwards.
 TEST(ExchangeTest, RefusesCorruptTruncatedForgedAndLyingMessages) {
@@ -234,10 +301,37 @@ TEST(ExchangeTest, RefusesCorruptTruncatedForgedAndLyingMessages) {
   EXPECT_EQ(a.exchange->PeerStats()[0].implausible_marks, 1u);
   EXPECT_EQ(a.store->HighWaterMark("a", 0), 0u);
 
+  // What b holds beyond its marks, of a lane that does not exist and stated unevenly.
+  exchange::Envelope ahead;
+  ahead.set_version(kExchangeProtocolVersion);
+  auto* no_lane = ahead.mutable_summary()->add_ahead();
+  no_lane->set_origin("a");
+  no_lane->set_lane(7);
+  no_lane->add_held(1);
+  auto* uneven = ahead.mutable_summary()->add_ahead();
+  uneven->set_origin("a");
+  uneven->set_lane(0);
+  uneven->add_partial_seq(1);
+  a.exchange->OnMessage("b", ahead.SerializeAsString(), now);
+  EXPECT_EQ(a.exchange->PeerStats()[0].refused_fragments, 5u);
+
+  // A piece of the next item, then the whole item cut differently (another sender's fragment
+  // size): the longer piece replaces the shorter one.
+  exchange::Envelope piece;
+  piece.set_version(kExchangeProtocolVersion);
+  const std::string next = Payload("b", 0, 3, 400);
+  const uint32_t next_crc = Crc32::Of(std::span<const uint8_t>(reinterpret_cast<const uint8_t*>(next.data()), next.size()));
+  fragment(piece, "b", 3, next, 0, 100, next_crc);
+  a.exchange->OnMessage("b", piece.SerializeAsString(), now);
+  piece.mutable_fragments(0)->set_data(next);
+  a.exchange->OnMessage("b", piece.SerializeAsString(), now);
+  EXPECT_EQ(a.store->HighWaterMark("b", 0), 1u);  // held until item 2 arrives
+
   // The same honest message twice: stored once.
   a.exchange->OnMessage("b", bytes, now);
   a.exchange->OnMessage("b", bytes, now);
-  EXPECT_EQ(a.store->HighWaterMark("b", 0), 2u);
+  EXPECT_EQ(a.store->HighWaterMark("b", 0), 3u);
+  EXPECT_EQ(a.payloads.at({"b", 0, 3}), next);
   EXPECT_EQ(a.seen.at({"b", 0, 2}), 1);
   EXPECT_EQ(a.exchange->PeerStats()[0].duplicates, 1u);
 
