@@ -20,6 +20,7 @@
 #include "daemon/simulated_robot.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/team_summary.h"
+#include "drivers/aravis_stereo_camera.h"
 #include "drivers/can_wheel_decoder.h"
 #include "drivers/replay/euroc_replay.h"
 #include "drivers/replay/mcap_replay.h"
@@ -133,17 +134,22 @@ Status Cairnd::Prepare() {
       sources_.push_back(std::make_unique<XsensImuDriver>(options_.imu.xsens, *imu_calibration_));
     }
   }
-  if (options_.source == SourceKind::kLive) {
+  // And the cameras: absent ones are reported and retried by the driver, the rest runs meanwhile.
+  if (options_.cameras.enabled && options_.source == SourceKind::kLive) {
+    stereo_calibration_ = options_.cameras.Calibration();
+    camera_rate_hz_ = options_.cameras.aravis.frame_rate_hz;
+    sources_.push_back(std::make_unique<AravisStereoCamera>(options_.cameras.aravis, *stereo_calibration_));
+  }
+  if (options_.source == SourceKind::kLive && !options_.cameras.enabled) {
     // Say what a live robot lacks, once, before it runs without it.
-    spdlog::warn("{}: no stereo camera driver is built yet: live runs record and stream the IMU and wheels, "
+    spdlog::warn("{}: cameras.enabled is false: this live run records and streams the IMU and wheels, "
                  "estimation and mapping wait for cameras",
                  config_path_);
   }
   if (sources_.empty()) {
     return InvalidArgumentError(config_path_ +
-                                ": no sensor source is enabled (this build has replay, the simulator, SocketCAN "
-                                "wheel odometry (can.enabled) and Xsens or IIO IMUs (imu.enabled); camera drivers "
-                                "are not built yet)");
+                                ": no sensor source is enabled (replay, the simulator, or for source: live "
+                                "cameras.enabled, imu.enabled, can.enabled)");
   }
   // Only once the sources are good: a start that fails moves nothing.
   KeepEarlierRun();
@@ -240,17 +246,16 @@ int Cairnd::Run() {
       }
     }
     const bool no_carriers = options_.detection.carriers_file.empty() && options_.source != SourceKind::kSim;
-    if (options_.detection.enabled && no_carriers && options_.source == SourceKind::kReplay) {
-      // A recording says nothing about the team's tags: replays run without detection unless told.
-      spdlog::warn("{}: detection.carriers_file is empty: robot detection is off for this replay", config_path_);
+    if (options_.detection.enabled && no_carriers) {
+      // A recording says nothing about the team's tags, and a robot must be told which tag is on
+      // which teammate: without that file it runs everything but detection.
+      spdlog::warn("{}: detection.carriers_file is empty (which tag is on which robot): robot detection is off "
+                   "for this {} run",
+                   config_path_, options_.source == SourceKind::kReplay ? "replay" : "live");
     } else if (options_.detection.enabled) {
-      Expected<TagCarrierTable> table = InvalidArgumentError(
-          "detection.carriers_file: needed outside the simulator (which tag is on which robot)");
-      if (!options_.detection.carriers_file.empty()) {
-        table = TagCarrierTable::Load(options_.detection.carriers_file);
-      } else if (options_.source == SourceKind::kSim) {
-        table = SimulatedTagCarriers(options_, config_path_);
-      }
+      Expected<TagCarrierTable> table = options_.detection.carriers_file.empty()
+                                            ? SimulatedTagCarriers(options_, config_path_)
+                                            : TagCarrierTable::Load(options_.detection.carriers_file);
       // A relative error table is the profile's: configs/detection/ beside it, installed or not.
       std::filesystem::path error_table = options_.detection.error_table;
       if (!error_table.empty() && error_table.is_relative())

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/sim_robot.h"
+#include "sim/terrain.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -23,6 +25,32 @@ TEST(ShippedConfigsTest, EveryConfigUnderConfigsLoads) {
     ++loaded;
   }
   EXPECT_GE(loaded, 3);
+}
+
+// The profiles' live cameras are the simulated robots' (a bench that serves the simulator's images
+// to the real drivers needs them to agree), in the convention of imu.T_body_imu.
+TEST(ShippedConfigsTest, LiveCamerasAreTheSimulatedRobots) {
+  sim::WorldOptions world;
+  const sim::Terrain terrain = sim::Terrain::Generate(world);
+  const sim::SimRobot rover = sim::MakeRover(terrain, "rover", 0, 1, 5.0, 1.0, world.tag_size);
+  const sim::SimRobot hexacopter = sim::MakeHexacopter(terrain, "hexacopter", 1, 1, 5.0, 1.0, world.tag_size);
+  for (const auto& [file, robot] : {std::pair{"rover.yaml", &rover}, std::pair{"hexacopter.yaml", &hexacopter}}) {
+    SCOPED_TRACE(file);
+    auto o = LoadCairndOptions(testing::SourceDir() + "/configs/" + file, {});
+    ASSERT_TRUE(o.ok()) << o.status().message();
+    EXPECT_TRUE(o->cameras.enabled);
+    const StereoCalibration c = o->cameras.Calibration();
+    EXPECT_DOUBLE_EQ(o->cameras.aravis.frame_rate_hz, robot->camera_rate_hz);
+    for (const auto& [mine, theirs] : {std::pair{&c.left, &robot->stereo.left}, std::pair{&c.right, &robot->stereo.right}}) {
+      EXPECT_EQ(mine->intrinsics.width, theirs->intrinsics.width);
+      EXPECT_EQ(mine->intrinsics.height, theirs->intrinsics.height);
+      EXPECT_DOUBLE_EQ(mine->intrinsics.fx, theirs->intrinsics.fx);
+      EXPECT_DOUBLE_EQ(mine->intrinsics.cx, theirs->intrinsics.cx);
+      EXPECT_DOUBLE_EQ(mine->intrinsics.cy, theirs->intrinsics.cy);
+      EXPECT_LT((mine->T_body_cam.translation() - theirs->T_body_cam.translation()).norm(), 1e-9);
+      EXPECT_LT(Eigen::AngleAxisd(mine->T_body_cam.linear().transpose() * theirs->T_body_cam.linear()).angle(), 1e-4);
+    }
+  }
 }
 
 // An output folder's config.yaml from an earlier version (here: the rover profile with one key

@@ -17,6 +17,7 @@
 #include "daemon/pipeline/mapping_stage_options.h"
 #include "daemon/telemetry/live_stream_options.h"
 #include "daemon/telemetry/recording_options.h"
+#include "drivers/camera_device_options.h"
 #include "drivers/can_wheel_options.h"
 #include "drivers/imu_device_options.h"
 #include "drivers/replay/replay_options.h"
@@ -105,6 +106,7 @@ struct CairndOptions {
   SimSourceOptions sim;
   CanWheelOptions can;
   ImuDeviceOptions imu;
+  CameraDeviceOptions cameras;
   ExecutorsOptions executors;
   QueueOptions queues;
   DaemonOptions daemon;
@@ -129,6 +131,7 @@ struct CairndOptions {
     v.Section("sim", sim);
     v.Section("can", can);
     v.Section("imu", imu);
+    v.Section("cameras", cameras);
     v.Section("executors", executors);
     v.Section("queues", queues);
     v.Section("daemon", daemon);

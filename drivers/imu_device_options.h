@@ -12,6 +12,7 @@
 #include "common/status.h"
 #include "drivers/iio_imu_options.h"
 #include "drivers/xsens_imu_options.h"
+#include "drivers/xyz_rpy_pose.h"
 #include "hal/calibration.h"
 
 namespace cairn {
@@ -45,12 +46,7 @@ struct ImuDeviceOptions {
 
   ImuCalibration Calibration() const {
     ImuCalibration c;
-    c.T_body_imu = Eigen::Isometry3d::Identity();
-    c.T_body_imu.translation() = Eigen::Vector3d(T_body_imu[0], T_body_imu[1], T_body_imu[2]);
-    c.T_body_imu.linear() = (Eigen::AngleAxisd(T_body_imu[5], Eigen::Vector3d::UnitZ()) *
-                             Eigen::AngleAxisd(T_body_imu[4], Eigen::Vector3d::UnitY()) *
-                             Eigen::AngleAxisd(T_body_imu[3], Eigen::Vector3d::UnitX()))
-                                .toRotationMatrix();
+    c.T_body_imu = PoseFromXyzRpy(T_body_imu);
     c.rate_hz = driver == ImuDriverKind::kXsens ? xsens.rate_hz : iio.rate_hz;
     c.gyro_noise_density = gyro_noise_density;
     c.gyro_random_walk = gyro_random_walk;

@@ -33,6 +33,8 @@ packages=(
   verilator yosys
   # the team exchange: ZeroMQ with CURVE (libsodium); link tests drop packets with nftables
   libzmq3-dev cppzmq-dev libsodium-dev nftables
+  # GigE Vision stereo cameras (Aravis; its fake camera serves the driver's tests)
+  libaravis-dev libusb-1.0-0-dev
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)

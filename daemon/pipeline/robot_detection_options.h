@@ -37,7 +37,7 @@ struct RobotDetectionOptions {
   double prediction_max_age = 10.0;   // s
   double prediction_max_area = 0.5;   // of the image
   // Which tag is on which robot or landmark (detection/tag_carrier_table.h); "" with `source: sim`
-  // takes the simulated world's.
+  // takes the simulated world's, and turns detection off in live runs and replays (said at start).
   std::string carriers_file;
   double corner_error = 0.5;  // px, eq. 6.9's corner perturbation
   // The covariance of a sighting (detection/tag_error_model.h): combined, thesis, table, online,
