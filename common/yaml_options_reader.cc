@@ -273,7 +273,8 @@ Expected<YAML::Node> ParseListDocument(const std::string& text, const std::strin
   }
   if (!root.IsMap()) return InvalidArgumentError(source + ": expected a mapping with the key '" + key + "'");
   for (const auto& entry : root) {
-    const std::string name = entry.first.as<std::string>();
+    // A key that is itself a list or a mapping (YAML's complex keys) names nothing.
+    const std::string name = entry.first.IsScalar() ? entry.first.Scalar() : "(not a name)";
     if (name != key) {
       const YAML::Mark mark = entry.first.Mark();
       return InvalidArgumentError(source + (mark.line < 0 ? "" : ":" + std::to_string(mark.line + 1)) +

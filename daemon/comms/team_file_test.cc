@@ -45,6 +45,11 @@ TEST(TeamFileTest, RefusesBadValues) {
   EXPECT_FALSE(TeamFile::Parse("members: []\n", "team.yaml").ok());
   EXPECT_FALSE(TeamFile::Parse("robots:\n" + Member("rover", "a", 1), "team.yaml").ok());
   EXPECT_FALSE(TeamFile::Parse("members: [", "team.yaml").ok());
+  // A key that is itself a list (a YAML complex key) is refused, not thrown on.
+  const auto complex_key = TeamFile::Parse("? [members]\n: 1\n", "team.yaml");
+  ASSERT_FALSE(complex_key.ok());
+  EXPECT_NE(complex_key.status().message().find("team.yaml:1: unknown key"), std::string::npos)
+      << complex_key.status().message();
   EXPECT_FALSE(TeamFile::Load("/nonexistent/team.yaml").ok());
 }
 
