@@ -295,10 +295,7 @@ void Exchange::OnFragment(Peer& peer, const void* fragment_ptr, Timestamp now) {
   if (got.conflict) ++peer.stats.refused_fragments;
   if (got.full) ++stats_.reorder_dropped;
   if (!got.complete) return;
-  std::string payload = std::move(got.payload);
-  const uint16_t kind = got.kind;
-  const uint32_t crc = got.crc;
-  if (CrcOf(payload) != crc) {
+  if (CrcOf(got.payload) != got.crc) {
     ++peer.stats.refused_fragments;
     stats_.last_error = "item " + f.origin() + "/" + std::to_string(f.lane()) + "/" + std::to_string(f.seq()) +
                         " from " + peer.stats.name + " fails its CRC";
@@ -306,8 +303,8 @@ void Exchange::OnFragment(Peer& peer, const void* fragment_ptr, Timestamp now) {
   }
   StoreItem item;
   item.key = ItemKey{f.origin(), static_cast<uint8_t>(f.lane()), f.seq()};
-  item.kind = kind;
-  item.payload = std::move(payload);
+  item.kind = got.kind;
+  item.payload = std::move(got.payload);
   Accept(peer, std::move(item));
 }
 
