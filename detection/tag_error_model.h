@@ -11,6 +11,14 @@
 //   reprojection errors against the table's corner error), and the moment-matched covariance of
 //   the two is the result: where the minima compete it spans both. On rendered tags it is the
 //   nearest to consistent of the models (docs/results.md#robot-detection).
+// propagated: the corners' linear propagation J J^T of this detection (TagPose::corner_jacobian:
+//   its correlations, and which axes the view leaves weak), scaled to the level the table measured
+//   at this distance and angle (the median over the six coordinates of their ratio), with a floor
+//   of 5 % of the table's variance; IPPE's other minimum enters as in combined, weighted by the
+//   larger of the residuals' likelihood and the share of eq. 6.9's perturbed corner sets that
+//   jumped to it. Nearer to consistent than combined on rendered tags, but not the default: in a
+//   team mission with faults the robots' graphs, fed these tighter sightings, settled in different
+//   minima of their robust loss (docs/results.md#robot-detection).
 // thesis: per coordinate the larger of the table's sigma and the largest deviation of the 257
 //   solutions from their mean (TagPose::covariance), as thesis 6.2.3 combines them.
 // table, online: either half of the thesis' model alone; constant (eq. 8.1: 1 cm, 1.3 deg) and
@@ -25,9 +33,10 @@
 
 namespace cairn {
 
-enum class TagErrorKind { kCombined, kThesis, kTable, kOnline, kConstant, kQuadratic };
+enum class TagErrorKind { kCombined, kPropagated, kThesis, kTable, kOnline, kConstant, kQuadratic };
 
-// "combined", "thesis", "table", "online", "constant", "quadratic"; an error names the accepted ones.
+// "combined", "propagated", "thesis", "table", "online", "constant", "quadratic"; an error names
+// the accepted ones.
 Expected<TagErrorKind> ParseTagErrorKind(const std::string& name);
 const char* TagErrorKindName(TagErrorKind kind);
 

@@ -17,14 +17,15 @@ std::shared_ptr<const TagErrorTable> FlatTable(double sigma) {
 }
 
 TEST(TagErrorModelTest, NamesParseAndUnknownOnesAreRefused) {
-  for (const char* name : {"combined", "thesis", "table", "online", "constant", "quadratic"}) {
+  for (const char* name : {"combined", "propagated", "thesis", "table", "online", "constant", "quadratic"}) {
     const auto k = ParseTagErrorKind(name);
     ASSERT_TRUE(k.ok()) << name;
     EXPECT_STREQ(TagErrorKindName(*k), name);
   }
   const auto bad = ParseTagErrorKind("lut");
   ASSERT_FALSE(bad.ok());
-  EXPECT_NE(bad.status().message().find("combined, thesis, table"), std::string::npos);
+  EXPECT_NE(bad.status().message().find("combined, propagated, thesis, table"), std::string::npos);
+  EXPECT_FALSE(TagErrorModel::Create(TagErrorKind::kPropagated, nullptr).ok());
   EXPECT_FALSE(TagErrorModel::Create(TagErrorKind::kCombined, nullptr).ok());
   EXPECT_FALSE(TagErrorModel::Create(TagErrorKind::kTable, std::make_shared<TagErrorTable>()).ok());
   EXPECT_FALSE(TagErrorModel::Create(TagErrorKind::kThesis, nullptr).ok());
@@ -58,6 +59,20 @@ TEST(TagErrorModelTest, EachModelGivesItsCovariance) {
   EXPECT_NEAR(m(0, 3), 0.00025, 1e-12);
   pose.sample_covariance = Matrix6d::Identity() * 1e-8;  // steadier than the table: the table holds
   EXPECT_NEAR(TagErrorModel::Create(TagErrorKind::kCombined, table, 0.5)->Covariance(pose, 0.16)(2, 2), 1e-4, 1e-12);
+  // Propagated: this detection's propagation J J^T, scaled so that the median coordinate matches
+  // the table (1e-4 everywhere), plus 5 % of the table; correlations kept.
+  pose.corner_jacobian.setZero();
+  pose.corner_jacobian.col(0) << 0.01, 0.0, 0.0, 0.01, 0.0, 0.0;  // moves x and pitch together
+  pose.corner_jacobian(1, 1) = 0.01;
+  pose.corner_jacobian(2, 2) = pose.corner_jacobian(4, 4) = pose.corner_jacobian(5, 5) = 0.02;
+  // Variances 1, 1, 4, 1, 4, 4 (x 1e-4): the table's ratios 1, 1, 0.25, 1, 0.25, 0.25; median 0.625.
+  const Matrix6d p = TagErrorModel::Create(TagErrorKind::kPropagated, table)->Covariance(pose, 0.16);
+  EXPECT_NEAR(p(0, 0), 0.625e-4 + 0.05e-4, 1e-13);
+  EXPECT_NEAR(p(5, 5), 2.5e-4 + 0.05e-4, 1e-13);
+  EXPECT_NEAR(p(0, 3), 0.625e-4, 1e-13);
+  EXPECT_EQ(p(1, 2), 0.0);
+  pose.corner_jacobian.setZero();  // no propagation (sampling off): the table's diagonal
+  EXPECT_NEAR(TagErrorModel::Create(TagErrorKind::kPropagated, table)->Covariance(pose, 0.16)(2, 2), 1e-4, 1e-12);
   // Thesis: the larger of the two, coordinate by coordinate.
   const Matrix6d c = cov(TagErrorKind::kThesis);
   EXPECT_NEAR(c(0, 0), 1e-4, 1e-12);
@@ -98,6 +113,13 @@ TEST(TagErrorModelTest, CompetingMinimaWidenTheCombinedCovarianceAlongTheirDiffe
   // The other explains them far worse (1 px against 0.1 px at 0.25 px noise): nothing added.
   pose.alternative_reprojection_error = 1.0;
   EXPECT_NEAR(model->Covariance(pose, 0.16)(3, 3), 1e-4, 1e-9);
+  // The propagated model also weighs the perturbed corner sets that jumped to it: 64 of 256 add
+  // 0.25 * 0.75 of it; the combined model, whose spread holds those jumps already, does not.
+  pose.solved_samples = 256;
+  pose.flipped_samples = 64;
+  EXPECT_NEAR(model->Covariance(pose, 0.16)(3, 3), 1e-4, 1e-9);
+  const auto propagated = TagErrorModel::Create(TagErrorKind::kPropagated, table);
+  EXPECT_NEAR(propagated->Covariance(pose, 0.16)(3, 3), 1e-4 + 0.1875 * 0.36, 1e-9);
 }
 
 TEST(TagErrorModelTest, TheResidualIsChiSquareAgainstTheTablesCornerError) {

@@ -63,6 +63,29 @@ std::vector<std::pair<Eigen::Isometry3d, double>> TagPoseEstimator::Solve(
   return out;
 }
 
+Eigen::Matrix<double, 6, 8> TagPoseEstimator::CornerJacobian(const std::array<Eigen::Vector2d, 4>& corners,
+                                                             const PinholeRadTan& camera,
+                                                             const Eigen::Isometry3d& T_cam_tag) const {
+  constexpr double kStep = 0.02;  // px: well inside the linear range, well above the solver's noise
+  Eigen::Matrix<double, 6, 8> J = Eigen::Matrix<double, 6, 8>::Zero();
+  for (int j = 0; j < 8; ++j) {
+    Eigen::Matrix<double, 6, 1> side[2];
+    for (int k = 0; k < 2; ++k) {
+      std::array<Eigen::Vector2d, 4> moved = corners;
+      moved[j / 2][j % 2] += k == 0 ? -kStep : kStep;
+      const auto s = Solve(moved, camera);
+      if (s.empty()) return Eigen::Matrix<double, 6, 8>::Zero();
+      side[k] = Deviation(T_cam_tag, s[0].first);
+      for (size_t i = 1; i < s.size(); ++i) {
+        const Eigen::Matrix<double, 6, 1> other = Deviation(T_cam_tag, s[i].first);
+        if (other.tail<3>().norm() < side[k].tail<3>().norm()) side[k] = other;
+      }
+    }
+    J.col(j) = (side[1] - side[0]) / (2.0 * kStep);
+  }
+  return J;
+}
+
 Expected<TagPose> TagPoseEstimator::Estimate(const std::array<Eigen::Vector2d, 4>& corners,
                                              const PinholeRadTan& camera) const {
   if (!(camera.fx > 0.0 && camera.fy > 0.0 && std::isfinite(camera.cx) && std::isfinite(camera.cy)))
@@ -110,6 +133,7 @@ Expected<TagPose> TagPoseEstimator::Estimate(const std::array<Eigen::Vector2d, 4
     }
     const auto s = Solve(moved, camera);
     if (s.empty()) continue;
+    ++pose.solved_samples;
     deviations[n++] = Deviation(pose.T_cam_tag, s[0].first);
     if (pose.has_alternative) {
       const double to_best = Deviation(pose.T_cam_tag, s[0].first).tail<3>().norm();
@@ -127,6 +151,7 @@ Expected<TagPose> TagPoseEstimator::Estimate(const std::array<Eigen::Vector2d, 4
   pose.covariance = sigma.cwiseAbs2().asDiagonal();
   for (size_t i = 0; i < n; ++i) pose.sample_covariance += (deviations[i] - mean) * (deviations[i] - mean).transpose();
   pose.sample_covariance /= static_cast<double>(n);
+  pose.corner_jacobian = CornerJacobian(corners, camera, pose.T_cam_tag);
   return pose;
 }
 

@@ -1,6 +1,8 @@
 // `cairn detect` as a user runs it: real photos, a rendered tag at a known pose, and bad input.
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -62,14 +64,27 @@ TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
   EXPECT_GT(built["detected"].number(), 6);
   EXPECT_GT(built["corner_rms_px"].number(), 0.0);
   EXPECT_LT(built["corner_rms_px"].number(), 1.0);
-  r = Detect({"check-lut", table, "--samples", "12", "--seed", "6"});
+  const std::string csv = dir + "/sightings.csv";
+  r = Detect({"check-lut", table, "--samples", "12", "--seed", "6", "--sightings-csv", csv});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue checked = JsonValue::Parse(r.output.substr(r.output.find('{')));
   EXPECT_EQ(checked["camera"].string(), "rover");
-  ASSERT_EQ(checked["models"].array().size(), 6u);
+  ASSERT_EQ(checked["models"].array().size(), 7u);
   EXPECT_EQ(checked["models"][0]["model"].string(), "combined");
   EXPECT_GT(checked["detected"].number(), 0);
   for (const JsonValue& m : checked["models"].array()) EXPECT_GT(m["mean_nees"].number(), 0.0) << m["model"].string();
+  // One row per sighting scored, every row as wide as the header.
+  std::ifstream rows(csv);
+  std::string line;
+  ASSERT_TRUE(std::getline(rows, line));
+  const auto columns = std::count(line.begin(), line.end(), ',');
+  EXPECT_NE(line.find("corner_jacobian47"), std::string::npos);
+  int scored = 0;
+  while (std::getline(rows, line)) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), columns);
+    ++scored;
+  }
+  EXPECT_EQ(scored, checked["detected"].number() - checked["refused_residual"].number());
   // Bad input: an unknown camera, a grid backwards, a table that is not one.
   r = Detect({"build-lut", "--camera", "drone", "--out", table});
   EXPECT_EQ(r.exit_code, 2);

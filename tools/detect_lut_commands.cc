@@ -43,12 +43,14 @@ constexpr const char* kBuildUsage =
 constexpr const char* kCheckUsage =
     "usage: cairn detect check-lut TABLE [--samples N (400)] [--seed S (2)] [--max-distance M (12)]\n"
     "                               [--max-angle DEG (60)] [--decimate F (2)] [--max-residual-chi2 X (13.8)]\n"
+    "                               [--sightings-csv FILE]\n"
     "  Renders N tags at random distances (up to 1.5x the table's last) and angles (0-80 deg) with\n"
     "  the table's camera, and prints per error model the NEES of the detected poses against the\n"
     "  truth, and how many tags were found, overall and within the distance and angle given.\n"
     "  --decimate 1 detects as the daemon's region scans do (2: its whole-frame scans). Detections\n"
     "  whose corners are farther from a square's projection than the chi-square bound are left out\n"
-    "  of the NEES, as the daemon refuses them.\n";
+    "  of the NEES, as the daemon refuses them. --sightings-csv writes each scored sighting (truth in\n"
+    "  the estimate's tangent, and every model's covariance) for analysis of models not built in.\n";
 
 struct Camera {
   std::string name;
@@ -109,6 +111,8 @@ struct Sighting {
   Eigen::Matrix<double, 6, 1> error = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> nearest_error = Eigen::Matrix<double, 6, 1>::Zero();
   double corner_sq = 0.0;  // px^2, summed over the 8 coordinates
+  std::array<Eigen::Vector2d, 4> corner_error{};  // px, detected minus true
+  std::array<Eigen::Vector2d, 4> true_corners{};  // px
 };
 
 // Renders (retrying other places in the image when the tag does not fit) and detects one tag.
@@ -143,10 +147,62 @@ Sighting RenderAndDetect(const sim::TagViewRenderer& renderer, const PinholeRadT
       const auto alt = TagPoseEstimator::Deviation(pose->T_cam_tag_alternative, truth);
       if (alt.tail<3>().norm() < s.error.tail<3>().norm()) s.nearest_error = alt;
     }
-    for (int c = 0; c < 4; ++c) s.corner_sq += (corners[c] - view->corners[c]).squaredNorm();
+    for (int c = 0; c < 4; ++c) {
+      s.corner_error[c] = corners[c] - view->corners[c];
+      s.true_corners[c] = view->corners[c];
+      s.corner_sq += s.corner_error[c].squaredNorm();
+    }
     break;
   }
   return s;
+}
+
+// One row per scored sighting: what a model can be computed from, and the truth it is judged by.
+std::string SightingCsvHeader() {
+  std::string h = "distance,view_angle,reprojection_error,alternative_reprojection_error,flipped_samples,corner_rms";
+  const auto add = [&h](const char* prefix, int count) {
+    for (int i = 0; i < count; ++i) h += "," + std::string(prefix) + std::to_string(i);
+  };
+  add("error", 6);
+  add("nearest_error", 6);
+  add("table_sigma", 6);
+  add("alternative_delta", 6);
+  add("sample_covariance", 36);
+  add("corner_error", 8);
+  add("true_corner", 8);
+  add("corner_jacobian", 48);
+  h += ",solved_samples";
+  return h + "\n";
+}
+
+void AppendSightingRow(const Sighting& si, const TagErrorTable& table, double tag_size, std::string* out) {
+  const TagPose& p = si.pose;
+  char buf[64];
+  const auto add = [&](double v) {
+    std::snprintf(buf, sizeof(buf), ",%.9g", v);
+    *out += buf;
+  };
+  std::snprintf(buf, sizeof(buf), "%.9g", p.distance);
+  *out += buf;
+  add(p.view_angle);
+  add(p.reprojection_error);
+  add(p.has_alternative ? p.alternative_reprojection_error : std::nan(""));
+  add(p.flipped_samples);
+  add(table.corner_rms());
+  for (int i = 0; i < 6; ++i) add(si.error[i]);
+  for (int i = 0; i < 6; ++i) add(si.nearest_error[i]);
+  const Eigen::Matrix<double, 6, 1> sigma = table.Sigma(p.distance, p.view_angle, tag_size);
+  for (int i = 0; i < 6; ++i) add(sigma[i]);
+  const Eigen::Matrix<double, 6, 1> delta = p.has_alternative
+                                                ? TagPoseEstimator::Deviation(p.T_cam_tag, p.T_cam_tag_alternative)
+                                                : Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i = 0; i < 6; ++i) add(delta[i]);
+  for (int i = 0; i < 36; ++i) add(p.sample_covariance(i / 6, i % 6));
+  for (int i = 0; i < 8; ++i) add(si.corner_error[i / 2][i % 2]);
+  for (int i = 0; i < 8; ++i) add(si.true_corners[i / 2][i % 2]);
+  for (int i = 0; i < 48; ++i) add(p.corner_jacobian(i / 8, i % 8));
+  add(p.solved_samples);
+  *out += "\n";
 }
 
 bool ParseTriple(const std::string& s, double* first, double* last, int* count) {
@@ -273,7 +329,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
 
 int RunDetectCheckLut(const CommandArgs& args) {
   if (WantsHelp(args)) return PrintUsage(kCheckUsage);
-  std::string path;
+  std::string path, sightings_csv;
   double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 2.0, max_residual_chi2 = 13.8;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
@@ -291,6 +347,8 @@ int RunDetectCheckLut(const CommandArgs& args) {
       ok = ParseCount(args.args[++i], 1.0, 8.0, &decimate);
     } else if (a == "--max-residual-chi2" && has) {
       ok = ParseCount(args.args[++i], 0.0, 1e9, &max_residual_chi2);
+    } else if (a == "--sightings-csv" && has) {
+      sightings_csv = args.args[++i];
     } else if (!a.empty() && a[0] != '-' && path.empty()) {
       path = a;
     } else {
@@ -326,8 +384,9 @@ int RunDetectCheckLut(const CommandArgs& args) {
   const double last = table->distance_at(table->distance_count() - 1);
   const double tag_size = table->tag_size();
 
-  const TagErrorKind kinds[] = {TagErrorKind::kCombined, TagErrorKind::kThesis,   TagErrorKind::kTable,
-                                TagErrorKind::kOnline,   TagErrorKind::kConstant, TagErrorKind::kQuadratic};
+  const TagErrorKind kinds[] = {TagErrorKind::kCombined, TagErrorKind::kPropagated, TagErrorKind::kThesis,
+                                TagErrorKind::kTable,    TagErrorKind::kOnline,     TagErrorKind::kConstant,
+                                TagErrorKind::kQuadratic};
   struct Score {
     std::vector<double> nees;
   };
@@ -336,6 +395,7 @@ int RunDetectCheckLut(const CommandArgs& args) {
   for (const TagErrorKind kind : kinds) models.push_back(*TagErrorModel::Create(kind, table, TagPoseOptions{}.corner_error));
   std::mt19937_64 rng(static_cast<uint64_t>(seed));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::string csv = SightingCsvHeader();
   int rendered = 0, detected = 0, in_range = 0, in_range_detected = 0, flips = 0, refused_residual = 0;
   for (int s = 0; s < static_cast<int>(samples); ++s) {
     const double d = table->distance_at(0) + unit(rng) * (1.5 * last - table->distance_at(0));
@@ -354,9 +414,16 @@ int RunDetectCheckLut(const CommandArgs& args) {
       continue;
     }
     flips += si.error.tail<3>().norm() > si.nearest_error.tail<3>().norm() + 1e-9;
+    if (!sightings_csv.empty()) AppendSightingRow(si, *table, tag_size, &csv);
     for (size_t m = 0; m < models.size(); ++m) {
       const Matrix6d P = models[m].Covariance(si.pose, tag_size);
       scores[m].nees.push_back(si.error.dot(P.ldlt().solve(si.error)));
+    }
+  }
+  if (!sightings_csv.empty()) {
+    if (Status st = WriteFileAtomically(sightings_csv, csv); !st.ok()) {
+      std::fprintf(stderr, "cairn detect check-lut: %s\n", st.message().c_str());
+      return 1;
     }
   }
   JsonWriter j;

@@ -40,8 +40,8 @@ struct RobotDetectionOptions {
   // takes the simulated world's, and turns detection off in live runs and replays (said at start).
   std::string carriers_file;
   double corner_error = 0.5;  // px, eq. 6.9's corner perturbation
-  // The covariance of a sighting (detection/tag_error_model.h): combined, thesis, table, online,
-  // constant or quadratic. Every model but online, constant and quadratic needs `error_table`,
+  // The covariance of a sighting (detection/tag_error_model.h): combined, propagated, thesis,
+  // table, online, constant or quadratic. Every model but online, constant and quadratic needs `error_table`,
   // built for this robot's camera by `cairn detect build-lut` (a relative path is taken from the
   // profile's folder).
   std::string error_model = "combined";
