@@ -22,9 +22,11 @@
 #include "daemon/team_summary.h"
 #include "drivers/aravis_stereo_camera.h"
 #include "drivers/can_wheel_decoder.h"
+#include "drivers/gpiod_trigger.h"
 #include "drivers/replay/euroc_replay.h"
 #include "drivers/replay/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
+#include "drivers/trigger_frame_stamper.h"
 #include "drivers/iio_imu_driver.h"
 #include "drivers/xsens_imu_driver.h"
 #include "estimation/graph/g2o_io.h"
@@ -139,6 +141,12 @@ Status Cairnd::Prepare() {
     stereo_calibration_ = options_.cameras.Calibration();
     camera_rate_hz_ = options_.cameras.aravis.frame_rate_hz;
     sources_.push_back(std::make_unique<AravisStereoCamera>(options_.cameras.aravis, *stereo_calibration_));
+    camera_source_ = sources_.back().get();
+  }
+  // And the cameras' trigger line, likewise reported and retried while its chip is absent.
+  if (options_.trigger.driver == TriggerDriverKind::kGpiod && options_.source == SourceKind::kLive) {
+    sources_.push_back(std::make_unique<GpiodTrigger>(options_.trigger.gpiod));
+    trigger_source_ = sources_.back().get();
   }
   if (options_.source == SourceKind::kLive && !options_.cameras.enabled) {
     // Say what a live robot lacks, once, before it runs without it.
@@ -149,7 +157,7 @@ Status Cairnd::Prepare() {
   if (sources_.empty()) {
     return InvalidArgumentError(config_path_ +
                                 ": no sensor source is enabled (replay, the simulator, or for source: live "
-                                "cameras.enabled, imu.enabled, can.enabled)");
+                                "cameras.enabled, imu.enabled, can.enabled, trigger.driver)");
   }
   // Only once the sources are good: a start that fails moves nothing.
   KeepEarlierRun();
@@ -344,8 +352,15 @@ int Cairnd::Run() {
   }
   if (!refused.empty()) spdlog::warn("real-time scheduling degraded: {}", refused);
 
+  // With a trigger line, the live cameras' frames take their edges' times on their way in.
+  std::unique_ptr<TriggerFrameStamper> stamper;
+  if (camera_source_ != nullptr && trigger_source_ != nullptr) {
+    stamper = std::make_unique<TriggerFrameStamper>(options_.trigger.stamping, &pipeline,
+                                                    trigger_source_->name() + "/stamping");
+  }
   for (auto& source : sources_) {
-    if (Status s = source->Start(&pipeline); !s.ok()) {
+    const bool stamped = stamper && (source.get() == camera_source_ || source.get() == trigger_source_);
+    if (Status s = source->Start(stamped ? static_cast<SensorSink*>(stamper.get()) : &pipeline); !s.ok()) {
       spdlog::error("source '{}' did not start: {}", source->name(), s.ToString());
     }
   }

@@ -48,6 +48,10 @@ class Cairnd {
   // Simulated runs: the robot's true trajectory, written as ground_truth.tum for evaluation.
   std::optional<Trajectory> ground_truth_;
   std::vector<std::unique_ptr<SensorSourceInterface>> sources_;
+  // The live cameras and their trigger line, among sources_: with both, Run() starts them into a
+  // TriggerFrameStamper in front of the pipeline.
+  SensorSourceInterface* camera_source_ = nullptr;
+  SensorSourceInterface* trigger_source_ = nullptr;
 };
 
 }  // namespace cairn

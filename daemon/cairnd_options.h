@@ -21,6 +21,7 @@
 #include "drivers/can_wheel_options.h"
 #include "drivers/imu_device_options.h"
 #include "drivers/replay/replay_options.h"
+#include "drivers/trigger_device_options.h"
 #include "estimation/filter/filter_options.h"
 #include "estimation/vo/vo_options.h"
 #include "sim/sim_source_options.h"
@@ -107,6 +108,7 @@ struct CairndOptions {
   CanWheelOptions can;
   ImuDeviceOptions imu;
   CameraDeviceOptions cameras;
+  TriggerDeviceOptions trigger;
   ExecutorsOptions executors;
   QueueOptions queues;
   DaemonOptions daemon;
@@ -132,6 +134,7 @@ struct CairndOptions {
     v.Section("can", can);
     v.Section("imu", imu);
     v.Section("cameras", cameras);
+    v.Section("trigger", trigger);
     v.Section("executors", executors);
     v.Section("queues", queues);
     v.Section("daemon", daemon);

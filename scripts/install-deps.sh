@@ -35,6 +35,8 @@ packages=(
   libzmq3-dev cppzmq-dev libsodium-dev nftables
   # GigE Vision stereo cameras (Aravis; its fake camera serves the driver's tests)
   libaravis-dev libusb-1.0-0-dev
+  # the cameras' trigger line (GPIO character device, libgpiod 1.6)
+  libgpiod-dev
 )
 if [[ "${CAIRN_CROSS:-0}" == "1" ]]; then
   packages+=(g++-aarch64-linux-gnu g++-arm-linux-gnueabihf)
