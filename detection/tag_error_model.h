@@ -16,9 +16,8 @@
 //   at this distance and angle (the median over the six coordinates of their ratio), with a floor
 //   of 5 % of the table's variance; IPPE's other minimum enters as in combined, weighted by the
 //   larger of the residuals' likelihood and the share of eq. 6.9's perturbed corner sets that
-//   jumped to it. Nearer to consistent than combined on rendered tags, but not the default: in a
-//   team mission with faults the robots' graphs, fed these tighter sightings, settled in different
-//   minima of their robust loss (docs/results.md#robot-detection).
+//   jumped to it. Nearer to consistent than combined on rendered tags; not yet the default
+//   (docs/results.md#robot-detection).
 // thesis: per coordinate the larger of the table's sigma and the largest deviation of the 257
 //   solutions from their mean (TagPose::covariance), as thesis 6.2.3 combines them.
 // table, online: either half of the thesis' model alone; constant (eq. 8.1: 1 cm, 1.3 deg) and

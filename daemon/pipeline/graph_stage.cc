@@ -158,7 +158,7 @@ void GraphStage::OnFrameSwitch(const FrameSwitchEvent& e) {
 
 void GraphStage::Finish() {
   if (graph_.num_factors() == 0) return;
-  const SlamUpdateStats stats = graph_.SolveFull();
+  const SlamUpdateStats stats = graph_.SolveFinal();
   if (stats.solved) ++report_.solves;
   report_.final_cost = stats.cost;
   report_.chi2 = graph_.Chi2();

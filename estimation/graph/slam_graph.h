@@ -121,6 +121,11 @@ class SlamGraph {
   SlamUpdateStats Update();
   // Waits for a running full solve, merges it, and optimizes the whole graph to convergence.
   SlamUpdateStats SolveFull();
+  // The last solve of a mission: SolveFull() from the current estimate, and again from a chordal
+  // re-initialization; the lower cost is kept (the chordal one on a tie). Robots holding the same
+  // factors have different warm starts (their own incremental histories), and with robust losses
+  // those can settle in different minima; the chordal start is the same for every robot.
+  SlamUpdateStats SolveFinal();
   // Waits for a running full solve and merges it (no further optimization).
   void WaitForBackground();
   // Waits and updates until no full solve runs (a merged one may start another for the factors
@@ -172,6 +177,8 @@ class SlamGraph {
   SlamUpdateStats SolveWindow(const std::vector<uint64_t>& seeds);
   std::vector<uint64_t> WindowAround(const std::vector<uint64_t>& seeds) const;
   GraphSnapshot Snapshot() const;
+  // Writes the snapshot's poses back into the variables of the same keys.
+  void SetPoses(const GraphSnapshot& snapshot);
   void StartFullSolve(bool chordal);
   // Merges a finished full solve; returns false (and drops it) when the graph's structure changed.
   bool MergeFullSolve();
