@@ -112,15 +112,10 @@ void XsensImuDriver::Fault(DeviceFaultKind kind, const std::string& detail) {
 }
 
 void XsensImuDriver::FormatFault(const std::string& detail, Timestamp now) {
-  ++format_faults_unreported_;
-  if (have_format_report_ && now - last_format_report_ < Duration::Seconds(1.0)) return;
+  const uint64_t count = format_faults_.Add(1, now);
+  if (count == 0) return;
   Fault(DeviceFaultKind::kCorruptSample,
-        format_faults_unreported_ > 1
-            ? detail + " (" + std::to_string(format_faults_unreported_) + " messages since the last report)"
-            : detail);
-  format_faults_unreported_ = 0;
-  have_format_report_ = true;
-  last_format_report_ = now;
+        count > 1 ? detail + " (" + std::to_string(count) + " messages since the last report)" : detail);
 }
 
 Status XsensImuDriver::Command(std::stop_token stop, uint8_t mid, std::span<const uint8_t> payload) {

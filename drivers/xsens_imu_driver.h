@@ -21,6 +21,7 @@
 
 #include "common/monotonic_clock.h"
 #include "drivers/device_clock_mapper.h"
+#include "drivers/fault_throttle.h"
 #include "drivers/mtdata2_decoder.h"
 #include "drivers/xbus_framer.h"
 #include "drivers/xsens_imu_options.h"
@@ -83,9 +84,7 @@ class XsensImuDriver final : public ImuInterface {
   int awaited_ack_ = -1;
   bool acked_ = false;
   std::string device_error_;
-  bool have_format_report_ = false;
-  Timestamp last_format_report_;
-  uint64_t format_faults_unreported_ = 0;
+  FaultThrottle format_faults_;
   std::atomic<uint64_t> samples_{0}, corrupt_{0}, lost_{0}, reconnections_{0}, configurations_{0};
   std::jthread thread_;
 };
