@@ -265,11 +265,14 @@ int Cairnd::Run() {
                                             ? SimulatedTagCarriers(options_, config_path_)
                                             : TagCarrierTable::Load(options_.detection.carriers_file);
       // A relative error table is the profile's: configs/detection/ beside it, installed or not.
-      std::filesystem::path error_table = options_.detection.error_table;
-      if (!error_table.empty() && error_table.is_relative())
-        error_table = std::filesystem::path(config_path_).parent_path() / error_table;
+      const auto resolve = [&](const std::string& name) {
+        std::filesystem::path path = name;
+        if (!path.empty() && path.is_relative()) path = std::filesystem::path(config_path_).parent_path() / path;
+        return path.string();
+      };
       Status s = table.ok() ? pipeline.EnableDetection(options_.detection, std::move(*table), options_.robot.name,
-                                                       error_table.string())
+                                                       resolve(options_.detection.error_table),
+                                                       resolve(options_.detection.region_error_table))
                             : table.status();
       if (!s.ok()) {
         spdlog::error("{}: detection: {}", config_path_, s.ToString());

@@ -82,6 +82,7 @@ Expected<std::vector<TagDetection>> TagDetector::Detect(const Image& image, cons
     t.id = d->id;
     t.hamming = d->hamming;
     t.decision_margin = d->decision_margin;
+    t.decimate = options_.decimate;
     // libapriltag puts pixel centres at +0.5; the camera models put them at whole numbers.
     const double ox = box.x - 0.5, oy = box.y - 0.5;
     for (size_t c = 0; c < 4; ++c) {

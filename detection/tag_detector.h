@@ -53,6 +53,7 @@ struct TagDetection {
   double decision_margin = 0.0;
   std::array<Eigen::Vector2d, 4> corners;  // px, full image
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  double decimate = 1.0;  // of the detector that found it: its corners' accuracy depends on it
 };
 
 // Pixel rectangle [x, x + width) x [y, y + height).

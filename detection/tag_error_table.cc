@@ -1,11 +1,13 @@
 #include "detection/tag_error_table.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "common/angles.h"
 
@@ -48,7 +50,7 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
   std::istringstream lines(text);
   std::string line;
   int number = 0;
-  bool magic = false, camera = false, size = false, corner = false, distances = false, angles = false;
+  bool magic = false, camera = false, size = false, corner = false, decimate = false, distances = false, angles = false;
   size_t row = 0;
   int last_line = 0;
   while (std::getline(lines, line)) {
@@ -63,11 +65,14 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
       int version = 0;
       if (key != kMagic || !(words >> version))
         return InvalidArgumentError(at + ": not a tag error table (expected '" + kMagic + " 1')");
-      if (version != 1) return InvalidArgumentError(at + ": version " + std::to_string(version) + " is not known (1 is)");
+      if (version == 1)
+        return InvalidArgumentError(at + ": version 1 tables do not say which detector decimation they were built for; "
+                                         "rebuild it with cairn detect build-lut");
+      if (version != 2) return InvalidArgumentError(at + ": version " + std::to_string(version) + " is not known (2 is)");
       magic = true;
       continue;
     }
-    const bool header_done = camera && size && corner && distances && angles;
+    const bool header_done = camera && size && corner && decimate && distances && angles;
     if (!header_done) {
       bool ok = true;
       if (key == "camera") {
@@ -80,6 +85,9 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
       } else if (key == "corner_rms") {
         ok = static_cast<bool>(words >> t.corner_rms_) && t.corner_rms_ >= 0.0;
         corner = true;
+      } else if (key == "decimate") {
+        ok = static_cast<bool>(words >> t.decimate_) && t.decimate_ >= 1.0 && t.decimate_ <= 8.0;
+        decimate = true;
       } else if (key == "distances") {
         ok = static_cast<bool>(words >> t.d0_ >> t.d1_ >> t.nd_) && t.d0_ > 0.0 && t.d1_ > t.d0_ && t.nd_ >= 2 &&
              t.nd_ <= 10000;
@@ -91,12 +99,20 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
         t.a0_ = a0 * kDegree;
         t.a1_ = a1 * kDegree;
         angles = true;
+      } else if (std::isdigit(static_cast<unsigned char>(key[0])) || key[0] == '.' || key[0] == '-') {
+        std::string missing;
+        for (const auto& [have, name] : {std::pair{camera, "camera"}, std::pair{size, "tag_size"},
+                                         std::pair{corner, "corner_rms"}, std::pair{decimate, "decimate"},
+                                         std::pair{distances, "distances"}, std::pair{angles, "angles"}}) {
+          if (!have) missing += std::string(missing.empty() ? "" : ", ") + name;
+        }
+        return InvalidArgumentError(at + ": a row before the header is complete (missing: " + missing + ")");
       } else {
         return InvalidArgumentError(at + ": '" + key +
-                                    "' is not a header key (camera, tag_size, corner_rms, distances, angles)");
+                                    "' is not a header key (camera, tag_size, corner_rms, decimate, distances, angles)");
       }
       if (!ok) return InvalidArgumentError(at + ": '" + key + "' has missing or out-of-range values");
-      if (camera && size && corner && distances && angles)
+      if (camera && size && corner && decimate && distances && angles)
         t.cells_.assign(static_cast<size_t>(t.nd_ * t.na_), TagErrorCell{});
       continue;
     }
@@ -123,8 +139,8 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
     t.cells_[row++] = c;
   }
   if (!magic) return InvalidArgumentError(source + ": empty; not a tag error table");
-  if (!(camera && size && corner && distances && angles))
-    return InvalidArgumentError(source + ": the header needs camera, tag_size, corner_rms, distances and angles");
+  if (!(camera && size && corner && decimate && distances && angles))
+    return InvalidArgumentError(source + ": the header needs camera, tag_size, corner_rms, decimate, distances and angles");
   if (row != t.cells_.size())
     return InvalidArgumentError(Where(source, last_line) + ": " + std::to_string(row) + " rows where distances x angles is " +
                                 std::to_string(t.cells_.size()));
@@ -134,10 +150,10 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
 std::string TagErrorTable::Serialize() const {
   std::string out;
   char buf[256];
-  out += std::string(kMagic) + " 1\n";
+  out += std::string(kMagic) + " 2\n";
   out += "# RMS pose error of a tag by distance and viewing angle (cairn detect build-lut)\n";
-  std::snprintf(buf, sizeof buf, "camera %s %d %d %.6g %.6g\ntag_size %.6g\ncorner_rms %.4f\n", camera_.c_str(), width_,
-                height_, fx_, fy_, tag_size_, corner_rms_);
+  std::snprintf(buf, sizeof buf, "camera %s %d %d %.6g %.6g\ntag_size %.6g\ncorner_rms %.4f\ndecimate %.6g\n", camera_.c_str(),
+                width_, height_, fx_, fy_, tag_size_, corner_rms_, decimate_);
   out += buf;
   std::snprintf(buf, sizeof buf, "distances %.6g %.6g %d\nangles %.6g %.6g %d\n", d0_, d1_, nd_, a0_ / kDegree, a1_ / kDegree, na_);
   out += buf;

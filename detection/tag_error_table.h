@@ -12,10 +12,11 @@
 // distance, rotation linearly.
 //
 // File (text; '#' starts a comment):
-//   cairn-tag-error-table 1
+//   cairn-tag-error-table 2
 //   camera <name> <width> <height> <fx> <fy>
 //   tag_size <m>
 //   corner_rms <px>                     the detector's corner error against the truth
+//   decimate <f>                        the detector's (tag_detector.h) the table was built with
 //   distances <first m> <last m> <count>
 //   angles <first deg> <last deg> <count>
 //   then count x count rows, distances outer: d angle rendered detected sx sy sz sphi_x sphi_y sphi_z
@@ -76,6 +77,10 @@ class TagErrorTable {
   double tag_size() const { return tag_size_; }
   double corner_rms() const { return corner_rms_; }
   void set_corner_rms(double px) { corner_rms_ = px; }
+  // Quads found at full resolution have smaller corner errors than at decimate 2, so a table
+  // holds for the one decimation it was built with.
+  double decimate() const { return decimate_; }
+  void set_decimate(double f) { decimate_ = f; }
 
  private:
   static double Step(double first, double last, int count) { return count > 1 ? (last - first) / (count - 1) : 0.0; }
@@ -85,6 +90,7 @@ class TagErrorTable {
   double fx_ = 0.0, fy_ = 0.0;
   double tag_size_ = 0.0;
   double corner_rms_ = 0.0;
+  double decimate_ = 2.0;
   double d0_ = 0.0, d1_ = 0.0, a0_ = 0.0, a1_ = 0.0;
   int nd_ = 0, na_ = 0;
   std::vector<TagErrorCell> cells_;

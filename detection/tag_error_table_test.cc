@@ -49,11 +49,13 @@ TEST(TagErrorTableTest, LooksUpBilinearlyAndScalesWithTheTagSize) {
 TEST(TagErrorTableTest, SerializesAndParsesBackTheSameTable) {
   TagErrorTable t = Grid();
   t.set_corner_rms(0.12);
+  t.set_decimate(1.0);
   const auto back = TagErrorTable::Parse(t.Serialize(), "t.lut");
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   EXPECT_EQ(back->camera(), "rover");
   EXPECT_EQ(back->width(), 1024);
   EXPECT_NEAR(back->corner_rms(), 0.12, 1e-9);
+  EXPECT_EQ(back->decimate(), 1.0);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) EXPECT_NEAR(back->cell(i, j).sigma[4], t.cell(i, j).sigma[4], 1e-5);
   EXPECT_NEAR(back->Sigma(1.7, 20 * kDegree, 0.2)[3], t.Sigma(1.7, 20 * kDegree, 0.2)[3], 1e-5);
@@ -67,30 +69,39 @@ TEST(TagErrorTableTest, MalformedFilesNameTheLine) {
   };
   EXPECT_NE(error_of("").find("x.lut: empty"), std::string::npos);
   EXPECT_NE(error_of("hello 1\n").find("x.lut:1: not a tag error table"), std::string::npos);
-  EXPECT_NE(error_of("cairn-tag-error-table 2\n").find("version 2"), std::string::npos);
-  // Lines: 1 magic, 2 comment, 3 camera, 4 tag_size, 5 corner_rms, 6 distances, 7 angles, 8 comment, 9.. rows.
+  EXPECT_NE(error_of("cairn-tag-error-table 3\n").find("version 3"), std::string::npos);
+  EXPECT_NE(error_of("cairn-tag-error-table 1\n").find("rebuild it"), std::string::npos);
+  // Lines: 1 magic, 2 comment, 3 camera, 4 tag_size, 5 corner_rms, 6 decimate, 7 distances, 8 angles, 9 comment,
+  // 10.. rows.
   std::string bad = good;
   bad.replace(bad.find("tag_size 0.16"), 13, "tag_size -1");
   EXPECT_NE(error_of(bad).find("x.lut:4: 'tag_size'"), std::string::npos) << error_of(bad);
   bad = good;
   bad.replace(bad.find("tag_size"), 8, "tag_sise");
   EXPECT_NE(error_of(bad).find("x.lut:4: 'tag_sise' is not a header key"), std::string::npos);
+  bad = good;
+  bad.replace(bad.find("decimate 2"), 10, "decimate 0.5");
+  EXPECT_NE(error_of(bad).find("x.lut:6: 'decimate'"), std::string::npos) << error_of(bad);
+  bad = good;
+  bad.erase(bad.find("decimate 2"), 11);
+  EXPECT_NE(error_of(bad).find("x.lut:9: a row before the header is complete (missing: decimate)"), std::string::npos)
+      << error_of(bad);
   // A row short of a number, a NaN, a row out of order, a row missing.
-  const size_t row9 = [&] {
+  const size_t row10 = [&] {
     size_t p = 0;
-    for (int l = 1; l < 9; ++l) p = good.find('\n', p) + 1;
+    for (int l = 1; l < 10; ++l) p = good.find('\n', p) + 1;
     return p;
   }();
-  const std::string row = good.substr(row9, good.find('\n', row9) - row9);
+  const std::string row = good.substr(row10, good.find('\n', row10) - row10);
   bad = good;
-  bad.replace(row9, row.size(), row.substr(0, row.rfind(' ')));
-  EXPECT_NE(error_of(bad).find("x.lut:9: a row needs 10 numbers"), std::string::npos) << error_of(bad);
+  bad.replace(row10, row.size(), row.substr(0, row.rfind(' ')));
+  EXPECT_NE(error_of(bad).find("x.lut:10: a row needs 10 numbers"), std::string::npos) << error_of(bad);
   bad = good;
-  bad.replace(row9, row.size(), row.substr(0, row.rfind(' ')) + " nan");
-  EXPECT_NE(error_of(bad).find("x.lut:9:"), std::string::npos) << error_of(bad);
+  bad.replace(row10, row.size(), row.substr(0, row.rfind(' ')) + " nan");
+  EXPECT_NE(error_of(bad).find("x.lut:10:"), std::string::npos) << error_of(bad);
   bad = good;
-  bad.replace(row9, row.size(), "5.0" + row.substr(row.find(' ')));
-  EXPECT_NE(error_of(bad).find("x.lut:9: row for distance 5"), std::string::npos) << error_of(bad);
+  bad.replace(row10, row.size(), "5.0" + row.substr(row.find(' ')));
+  EXPECT_NE(error_of(bad).find("x.lut:10: row for distance 5"), std::string::npos) << error_of(bad);
   bad = good.substr(0, good.rfind('\n', good.size() - 2) + 1);
   EXPECT_NE(error_of(bad).find("8 rows where distances x angles is 9"), std::string::npos) << error_of(bad);
   EXPECT_EQ(TagErrorTable::Load("/nonexistent/t.lut").status().code(), StatusCode::kNotFound);
@@ -130,7 +141,7 @@ TEST(TagErrorTableTest, EveryShippedTableLoadsAndGrowsWithDistance) {
     EXPECT_GT(far, 5.0 * near) << e.path();
     EXPECT_GT(t->corner_rms(), 0.0) << e.path();
   }
-  EXPECT_EQ(tables, 2);  // the rover's and the hexacopter's
+  EXPECT_EQ(tables, 4);  // the rover's and the hexacopter's, for whole-frame scans and region scans
 }
 
 }  // namespace

@@ -57,7 +57,7 @@ TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
   const std::string dir = testing::FreshTempDir("cairn_detect_lut");
   const std::string table = dir + "/rover.lut";
   auto r = Detect({"build-lut", "--camera", "rover", "--out", table, "--distances", "1,4,2", "--angles", "0,40,2",
-                   "--samples", "3", "--seed", "5"});
+                   "--samples", "3", "--seed", "5", "--decimate", "1"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue built = JsonValue::Parse(r.output.substr(r.output.find('{')));
   EXPECT_GE(built["rendered"].number(), 10);  // of 12: a near tag may not fit in 32 random places
@@ -69,6 +69,7 @@ TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue checked = JsonValue::Parse(r.output.substr(r.output.find('{')));
   EXPECT_EQ(checked["camera"].string(), "rover");
+  EXPECT_EQ(checked["decimate"].number(), 1.0);  // the table's, unless told otherwise
   ASSERT_EQ(checked["models"].array().size(), 7u);
   EXPECT_EQ(checked["models"][0]["model"].string(), "combined");
   EXPECT_GT(checked["detected"].number(), 0);

@@ -42,14 +42,14 @@ constexpr const char* kBuildUsage =
 
 constexpr const char* kCheckUsage =
     "usage: cairn detect check-lut TABLE [--samples N (400)] [--seed S (2)] [--max-distance M (12)]\n"
-    "                               [--max-angle DEG (60)] [--decimate F (2)] [--max-residual-chi2 X (13.8)]\n"
+    "                               [--max-angle DEG (60)] [--decimate F] [--max-residual-chi2 X (13.8)]\n"
     "                               [--sightings-csv FILE]\n"
     "  Renders N tags at random distances (up to 1.5x the table's last) and angles (0-80 deg) with\n"
     "  the table's camera, and prints per error model the NEES of the detected poses against the\n"
     "  truth, and how many tags were found, overall and within the distance and angle given.\n"
-    "  --decimate 1 detects as the daemon's region scans do (2: its whole-frame scans). Detections\n"
-    "  whose corners are farther from a square's projection than the chi-square bound are left out\n"
-    "  of the NEES, as the daemon refuses them. --sightings-csv writes each scored sighting (truth in\n"
+    "  --decimate: the detector's (default: the table's; 1 as the daemon's region scans, 2 as its\n"
+    "  whole-frame scans). Detections whose corners are farther from a square's projection than the\n"
+    "  chi-square bound are left out of the NEES, as the daemon refuses them. --sightings-csv writes each scored sighting (truth in\n"
     "  the estimate's tangent, and every model's covariance) for analysis of models not built in.\n";
 
 struct Camera {
@@ -317,6 +317,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
     return 1;
   }
   table.set_corner_rms(std::sqrt(corner_sq / std::max(corner_n, 1)));
+  table.set_decimate(decimate);
   table.FillAndSmooth();
   if (Status s = WriteFileAtomically(out, table.Serialize()); !s.ok()) {
     std::fprintf(stderr, "cairn detect build-lut: %s\n", s.ToString().c_str());
@@ -330,7 +331,7 @@ int RunDetectBuildLut(const CommandArgs& args) {
 int RunDetectCheckLut(const CommandArgs& args) {
   if (WantsHelp(args)) return PrintUsage(kCheckUsage);
   std::string path, sightings_csv;
-  double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 2.0, max_residual_chi2 = 13.8;
+  double samples = 400, seed = 2, max_distance = 12.0, max_angle = 60.0, decimate = 0.0, max_residual_chi2 = 13.8;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     const bool has = i + 1 < args.args.size();
@@ -369,6 +370,9 @@ int RunDetectCheckLut(const CommandArgs& args) {
     std::fprintf(stderr, "cairn detect check-lut: %s\n", loaded.status().message().c_str());
     return 1;
   }
+  // By default the detections are made as the table's were; another decimation judges the table
+  // where the daemon would refuse it (robot_detection_stage.h).
+  if (decimate == 0.0) decimate = loaded->decimate();
   const auto table = std::make_shared<const TagErrorTable>(std::move(*loaded));
   const sim::Terrain terrain = sim::Terrain::Generate(sim::WorldOptions{});
   // The table's camera, from its header.

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <thread>
 
 namespace cairn {
@@ -97,7 +98,7 @@ Status Pipeline::EnableGraph(const GraphStageOptions& options) {
 }
 
 Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrierTable table, const std::string& robot,
-                                 const std::string& error_table_path) {
+                                 const std::string& error_table_path, const std::string& region_error_table_path) {
   if (started_) return FailedPreconditionError("EnableDetection() after Start()");
   if (!graph_) return FailedPreconditionError("robot detection needs the graph enabled");
   if (table.empty()) return InvalidArgumentError("robot detection: the tag carrier table lists no tag");
@@ -105,8 +106,16 @@ Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrie
   if (options.every_nth_frame % options.roi_every_nth_frame != 0)
     return InvalidArgumentError("detection.roi_every_nth_frame (" + std::to_string(options.roi_every_nth_frame) +
                                 ") must divide detection.every_nth_frame (" + std::to_string(options.every_nth_frame) + ")");
-  auto model = RobotDetectionStage::MakeErrorModel(options, error_table_path, rectify_->camera());
+  auto model =
+      RobotDetectionStage::MakeErrorModel(options, error_table_path, options.detector.decimate, rectify_->camera());
   if (!model.ok()) return model.status();
+  std::optional<TagErrorModel> region_model;
+  if (!region_error_table_path.empty()) {
+    auto m = RobotDetectionStage::MakeErrorModel(options, region_error_table_path, options.roi_decimate,
+                                                 rectify_->camera(), "detection.region_error_table");
+    if (!m.ok()) return m.status();
+    region_model = std::move(*m);
+  }
   graph_->SetLandmarks(table.Landmarks());
   landmark_carriers_ = table.Landmarks();
   for (const auto& [id, mount] : table.tags()) {
@@ -117,7 +126,8 @@ Status Pipeline::EnableDetection(const RobotDetectionOptions& options, TagCarrie
   // A deterministic replay must not depend on how far the graph thread got by each image.
   predict_carriers_ = options.predicted_regions && !deterministic_;
   detection_ = std::make_unique<RobotDetectionStage>(options, std::move(table), std::move(*model), rectify_->camera(),
-                                                     rectify_->T_body_cam(), robot, graph_->robot());
+                                                     rectify_->T_body_cam(), robot, graph_->robot(),
+                                                     std::move(region_model));
   // Whole-frame scans on every every_nth_frame-th frame, region scans on every
   // roi_every_nth_frame-th: the stage gets the latter and counts the former among them.
   detection_every_ = options.roi_every_nth_frame;

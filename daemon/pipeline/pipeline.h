@@ -117,10 +117,10 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   Status EnableMatching(const SubmapMatchingOptions& options, const std::string& robot);
   // Detects teammates' and landmarks' tags on every `every_nth_frame`-th left rectified image
   // (detection executor) and adds the sightings to the graph as factors d and o (and to the team).
-  // `error_table_path` is options.error_table resolved ("" for none). Needs EnableGraph() first;
-  // call before Start().
+  // `error_table_path` and `region_error_table_path` are options.error_table and
+  // options.region_error_table resolved ("" for none). Needs EnableGraph() first; call before Start().
   Status EnableDetection(const RobotDetectionOptions& options, TagCarrierTable table, const std::string& robot,
-                         const std::string& error_table_path);
+                         const std::string& error_table_path, const std::string& region_error_table_path = "");
   // Shares this robot's frame switches, estimates, submaps and matches with the team through `team`
   // and takes teammates' items into the graph and the matcher (graph thread). Needs EnableGraph()
   // first; `team` must outlive the pipeline's threads. Call before Start().

@@ -42,10 +42,13 @@ struct RobotDetectionOptions {
   double corner_error = 0.5;  // px, eq. 6.9's corner perturbation
   // The covariance of a sighting (detection/tag_error_model.h): combined, propagated, thesis,
   // table, online, constant or quadratic. Every model but online, constant and quadratic needs `error_table`,
-  // built for this robot's camera by `cairn detect build-lut` (a relative path is taken from the
-  // profile's folder).
+  // built for this robot's camera and the whole-frame scans' decimation by `cairn detect build-lut`
+  // (a relative path is taken from the profile's folder). `region_error_table` is the same for the
+  // region scans' `roi_decimate` ("": they use `error_table`, which is wider than their errors
+  // where it was built at a coarser decimation).
   std::string error_model = "combined";
   std::string error_table;
+  std::string region_error_table;
   // Sightings beyond these are kept in detections.csv but not given to the graph (thesis 6.2.3:
   // far or edge-on tags flip between their two poses).
   double max_distance = 12.0;          // m, camera to tag
@@ -75,6 +78,7 @@ struct RobotDetectionOptions {
     v.Number("corner_error", corner_error, 0.0, 10.0, "px");
     v.Text("error_model", error_model);
     v.Text("error_table", error_table);
+    v.Text("region_error_table", region_error_table);
     v.Number("max_distance", max_distance, 0.1, 1000.0, "m");
     v.Number("max_sigma_translation", max_sigma_translation, 1e-4, 100.0, "m");
     v.Number("max_sigma_rotation", max_sigma_rotation, 1e-4, 3.2, "rad");

@@ -33,23 +33,28 @@ TagDetectorOptions DetectorOptions(TagDetectorOptions o, const TagCarrierTable& 
 }  // namespace
 
 Expected<TagErrorModel> RobotDetectionStage::MakeErrorModel(const RobotDetectionOptions& options,
-                                                            const std::string& table_path,
-                                                            const RectifiedStereoCamera& camera) {
+                                                            const std::string& table_path, double decimate,
+                                                            const RectifiedStereoCamera& camera,
+                                                            const std::string& key) {
   auto kind = ParseTagErrorKind(options.error_model);
   if (!kind.ok()) return kind.status().WithContext("detection.error_model");
   std::shared_ptr<const TagErrorTable> table;
   double scale = 1.0;
   if (!table_path.empty()) {
     auto loaded = TagErrorTable::Load(table_path);
-    if (!loaded.ok()) return loaded.status().WithContext("detection.error_table");
+    if (!loaded.ok()) return loaded.status().WithContext(key);
     // Same field of view (within 2 %), at most the table's resolution.
     scale = camera.f / loaded->fx();
     const double fov = camera.width / camera.f, table_fov = loaded->width() / loaded->fx();
     if (std::abs(fov / table_fov - 1.0) > 0.02 || scale > 1.02)
-      return InvalidArgumentError("detection.error_table: " + table_path + " was built for a " +
+      return InvalidArgumentError(key + ": " + table_path + " was built for a " +
                                   std::to_string(loaded->width()) + " px wide camera of f = " + Fixed(loaded->fx(), 1) +
                                   " px, this robot's rectified camera is " + std::to_string(camera.width) +
                                   " px wide with f = " + Fixed(camera.f, 1) + " px (build one: cairn detect build-lut)");
+    if (loaded->decimate() != decimate)
+      return InvalidArgumentError(key + ": " + table_path + " was built for detections at decimate " +
+                                  Fixed(loaded->decimate(), 2) + ", these are made at " + Fixed(decimate, 2) +
+                                  " (build one: cairn detect build-lut --decimate " + Fixed(decimate, 2) + ")");
     table = std::make_shared<const TagErrorTable>(std::move(*loaded));
   }
   auto model = TagErrorModel::Create(*kind, std::move(table), options.corner_error, std::min(scale, 1.0));
@@ -59,10 +64,12 @@ Expected<TagErrorModel> RobotDetectionStage::MakeErrorModel(const RobotDetection
 
 RobotDetectionStage::RobotDetectionStage(const RobotDetectionOptions& options, TagCarrierTable table,
                                          TagErrorModel error_model, const RectifiedStereoCamera& camera,
-                                         const Eigen::Isometry3d& T_body_cam, const std::string& robot, char letter)
+                                         const Eigen::Isometry3d& T_body_cam, const std::string& robot, char letter,
+                                         std::optional<TagErrorModel> region_error_model)
     : options_(options),
       table_(std::move(table)),
-      error_model_(std::move(error_model)),
+      error_model_(error_model),
+      region_error_model_(region_error_model ? std::move(*region_error_model) : std::move(error_model)),
       T_body_cam_(T_body_cam),
       robot_(robot),
       letter_(letter),
@@ -270,7 +277,8 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, const CarrierPredic
     t.has_alternative = pose->has_alternative;
     if (pose->has_alternative)
       t.T_observer_observed_alternative = T_body_cam_ * pose->T_cam_tag_alternative * T_tag_carrier;
-    const Matrix6d tag_covariance = error_model_.Covariance(*pose, mount->size);
+    const TagErrorModel& model = d.decimate == options_.detector.decimate ? error_model_ : region_error_model_;
+    const Matrix6d tag_covariance = model.Covariance(*pose, mount->size);
     t.covariance = CarrierCovariance(tag_covariance, T_tag_carrier);
     t.distance = pose->distance;
     t.view_angle = pose->view_angle;
@@ -279,7 +287,7 @@ void RobotDetectionStage::Process(const RectifiedPair& pair, const CarrierPredic
       sigma_t = std::max(sigma_t, std::sqrt(std::max(0.0, tag_covariance(i, i))));
       sigma_r = std::max(sigma_r, std::sqrt(std::max(0.0, tag_covariance(i + 3, i + 3))));
     }
-    const double residual = error_model_.ResidualChi2(*pose);
+    const double residual = model.ResidualChi2(*pose);
     if (pose->distance > options_.max_distance) {
       s.refused = "farther than " + Fixed(options_.max_distance, 1) + " m";
     } else if (residual > options_.max_residual_chi2) {

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,14 +59,18 @@ struct RobotDetectionReport {
 
 class RobotDetectionStage {
  public:
+  // `error_model` covers the whole-frame scans' detections; `region_error_model` the region scans'
+  // (none: `error_model` covers them too).
   RobotDetectionStage(const RobotDetectionOptions& options, TagCarrierTable table, TagErrorModel error_model,
                       const RectifiedStereoCamera& camera, const Eigen::Isometry3d& T_body_cam, const std::string& robot,
-                      char letter);
+                      char letter, std::optional<TagErrorModel> region_error_model = std::nullopt);
 
-  // The error model `options` name, for `camera`: loads the table (`table_path`, already resolved)
-  // and checks that it was built for a camera of this one's field of view.
+  // The error model `options` name for detections at `decimate` on `camera`: loads the table
+  // (`table_path`, already resolved; "" for none) and checks that it was built for a camera of this
+  // one's field of view and for that decimation. Errors name the option `key`.
   static Expected<TagErrorModel> MakeErrorModel(const RobotDetectionOptions& options, const std::string& table_path,
-                                                const RectifiedStereoCamera& camera);
+                                                double decimate, const RectifiedStereoCamera& camera,
+                                                const std::string& key = "detection.error_table");
 
   // Appends a sighting for every tag of another carrier in the pair's left image. Call with every
   // `roi_every_nth_frame`-th pair: each (every_nth_frame / roi_every_nth_frame)-th, starting with
@@ -101,6 +106,7 @@ class RobotDetectionStage {
   RobotDetectionOptions options_;
   TagCarrierTable table_;
   TagErrorModel error_model_;
+  TagErrorModel region_error_model_;
   PinholeRadTan camera_;
   Eigen::Isometry3d T_body_cam_;
   std::string robot_;

@@ -79,9 +79,12 @@ Eigen::Isometry3d TagInView(double distance, double yaw) {
   return T;
 }
 
-// The model the options name, with the rover's shipped table (this camera is the rover's).
+// The model the options name, with the rover's shipped table for the whole-frame scans' decimation
+// (this camera is the rover's).
 TagErrorModel ModelFor(const RobotDetectionOptions& o) {
-  auto m = RobotDetectionStage::MakeErrorModel(o, testing::SourceDir() + "/configs/detection/rover.lut", Camera());
+  const std::string table = o.detector.decimate == 1.0 ? "rover_d1.lut" : "rover.lut";
+  auto m = RobotDetectionStage::MakeErrorModel(o, testing::SourceDir() + "/configs/detection/" + table,
+                                               o.detector.decimate, Camera());
   EXPECT_TRUE(m.ok()) << m.status().ToString();
   return *m;
 }
@@ -153,7 +156,7 @@ TEST(RobotDetectionStageTest, AnErrorTableOfAnotherCameraOrAMissingOneIsRefusedA
   RobotDetectionOptions o = DetectionOptions();
   const std::string dir = testing::SourceDir() + "/configs/detection/";
   // The hexacopter's table on the rover's camera: another field of view.
-  auto m = RobotDetectionStage::MakeErrorModel(o, dir + "hexacopter.lut", Camera());
+  auto m = RobotDetectionStage::MakeErrorModel(o, dir + "hexacopter.lut", 2.0, Camera());
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.status().message().find("detection.error_table: " + dir + "hexacopter.lut was built for a 666 px wide"),
             std::string::npos)
@@ -163,17 +166,25 @@ TEST(RobotDetectionStageTest, AnErrorTableOfAnotherCameraOrAMissingOneIsRefusedA
   half.width /= 2;
   half.height /= 2;
   half.f /= 2;
-  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, dir + "rover.lut", half).ok());
-  m = RobotDetectionStage::MakeErrorModel(o, dir + "nonexistent.lut", Camera());
+  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, dir + "rover.lut", 2.0, half).ok());
+  // A table holds for the decimation it was built at.
+  m = RobotDetectionStage::MakeErrorModel(o, dir + "rover.lut", 1.0, Camera(), "detection.region_error_table");
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.status().message().find("detection.region_error_table: " + dir +
+                                      "rover.lut was built for detections at decimate 2.00, these are made at 1.00"),
+            std::string::npos)
+      << m.status().message();
+  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, dir + "rover_d1.lut", 1.0, Camera()).ok());
+  m = RobotDetectionStage::MakeErrorModel(o, dir + "nonexistent.lut", 2.0, Camera());
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.status().message().find("nonexistent.lut"), std::string::npos);
-  m = RobotDetectionStage::MakeErrorModel(o, "", Camera());  // combined needs a table
+  m = RobotDetectionStage::MakeErrorModel(o, "", 2.0, Camera());  // combined needs a table
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.status().message().find("needs an error table"), std::string::npos) << m.status().message();
   o.error_model = "online";
-  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, "", Camera()).ok());
+  EXPECT_TRUE(RobotDetectionStage::MakeErrorModel(o, "", 2.0, Camera()).ok());
   o.error_model = "gaussian";
-  m = RobotDetectionStage::MakeErrorModel(o, "", Camera());
+  m = RobotDetectionStage::MakeErrorModel(o, "", 2.0, Camera());
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.status().message().find("detection.error_model"), std::string::npos) << m.status().message();
 }
@@ -221,6 +232,30 @@ TEST(RobotDetectionStageTest, RegionScansFollowATagBetweenWholeFrameScans) {
   EXPECT_EQ(stage.report().region_scans, 3u);
   EXPECT_EQ(stage.report().idle, 1u);
   EXPECT_GT(stage.region_time().count(), 0u);
+}
+
+// Quads found at full resolution are more accurate than at decimate 2: the region scans' sightings
+// take the covariance of their own table, the whole-frame scans' that of theirs.
+TEST(RobotDetectionStageTest, RegionScansTakeTheErrorTableOfTheirDecimation) {
+  RobotDetectionOptions o = DetectionOptions();
+  o.detector.decimate = 2.0;
+  o.every_nth_frame = 2;
+  o.roi_every_nth_frame = 1;
+  RobotDetectionOptions full = o;
+  full.detector.decimate = 1.0;
+  RobotDetectionStage own(o, Table(), ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b', ModelFor(full));
+  RobotDetectionStage shared(o, Table(), ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  const cv::Mat image = testing::RenderTag(10, 0.16, TagInView(4.0, 20 * kDeg), Pinhole());
+  std::vector<TagSighting> a, b;
+  for (int64_t t : {0, 100'000'000}) {  // whole, then region
+    own.Process(PairOf(image, t), &a);
+    shared.Process(PairOf(image, t), &b);
+  }
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(own.report().region_scans, 1u);
+  EXPECT_TRUE(a[0].detection.covariance.isApprox(b[0].detection.covariance));
+  EXPECT_LT(a[1].detection.covariance.trace(), 0.8 * b[1].detection.covariance.trace());
 }
 
 // Where the graph would place a carrier whose tag `id` the camera sees at T_cam_tag, its place
