@@ -2,22 +2,21 @@
 // The covariance given to a tag's pose (thesis 6.2.3), from the precomputed error table
 // (tag_error_table.h) and the online spread of eq. 6.9's 256 corner perturbations.
 //
-// combined (the default): the sample covariance of the 257 solutions (TagPose::sample_covariance,
+// propagated (the default): the corners' linear propagation J J^T of this detection
+//   (TagPose::corner_jacobian: its correlations, and which axes the view leaves weak), scaled to the
+//   level the table measured at this distance and angle (the median over the six coordinates of
+//   their ratio), with a floor of 5 % of the table's variance. IPPE's other minimum enters as the
+//   second component of a mixture, weighted by the larger of the corners' likelihood under each
+//   (their reprojection errors against the table's corner error) and the share of eq. 6.9's
+//   perturbed corner sets that jumped to it; the moment-matched covariance of the two is the
+//   result, so where the minima compete it spans both. On rendered tags it is the nearest to
+//   consistent of the models (docs/results.md#robot-detection).
+// combined: the sample covariance of the 257 solutions (TagPose::sample_covariance,
 //   J diag(delta^2) J^T where the solver is linear) rescaled from the perturbation delta to the
 //   corner error the table measured, with each variance raised to the table's where that is
 //   larger. It keeps the correlations and the inflation where the perturbations jump between
-//   IPPE's minima, without the thesis' worst-case factor. IPPE's other minimum then enters as the
-//   second component of a mixture weighted by the likelihood of each given the corners (their
-//   reprojection errors against the table's corner error), and the moment-matched covariance of
-//   the two is the result: where the minima compete it spans both. On rendered tags it is the
-//   nearest to consistent of the models (docs/results.md#robot-detection).
-// propagated: the corners' linear propagation J J^T of this detection (TagPose::corner_jacobian:
-//   its correlations, and which axes the view leaves weak), scaled to the level the table measured
-//   at this distance and angle (the median over the six coordinates of their ratio), with a floor
-//   of 5 % of the table's variance; IPPE's other minimum enters as in combined, weighted by the
-//   larger of the residuals' likelihood and the share of eq. 6.9's perturbed corner sets that
-//   jumped to it. Nearer to consistent than combined on rendered tags; not yet the default
-//   (docs/results.md#robot-detection).
+//   IPPE's minima, without the thesis' worst-case factor. IPPE's other minimum enters as in
+//   propagated, weighted by the corners' likelihood only. About 2x wider than the errors.
 // thesis: per coordinate the larger of the table's sigma and the largest deviation of the 257
 //   solutions from their mean (TagPose::covariance), as thesis 6.2.3 combines them.
 // table, online: either half of the thesis' model alone; constant (eq. 8.1: 1 cm, 1.3 deg) and

@@ -40,13 +40,13 @@ struct RobotDetectionOptions {
   // takes the simulated world's, and turns detection off in live runs and replays (said at start).
   std::string carriers_file;
   double corner_error = 0.5;  // px, eq. 6.9's corner perturbation
-  // The covariance of a sighting (detection/tag_error_model.h): combined, propagated, thesis,
+  // The covariance of a sighting (detection/tag_error_model.h): propagated, combined, thesis,
   // table, online, constant or quadratic. Every model but online, constant and quadratic needs `error_table`,
   // built for this robot's camera and the whole-frame scans' decimation by `cairn detect build-lut`
   // (a relative path is taken from the profile's folder). `region_error_table` is the same for the
   // region scans' `roi_decimate` ("": they use `error_table`, which is wider than their errors
   // where it was built at a coarser decimation).
-  std::string error_model = "combined";
+  std::string error_model = "propagated";
   std::string error_table;
   std::string region_error_table;
   // Sightings beyond these are kept in detections.csv but not given to the graph (thesis 6.2.3:

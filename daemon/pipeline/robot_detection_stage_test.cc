@@ -234,17 +234,21 @@ TEST(RobotDetectionStageTest, RegionScansFollowATagBetweenWholeFrameScans) {
   EXPECT_GT(stage.region_time().count(), 0u);
 }
 
-// Quads found at full resolution are more accurate than at decimate 2: the region scans' sightings
-// take the covariance of their own table, the whole-frame scans' that of theirs.
-TEST(RobotDetectionStageTest, RegionScansTakeTheErrorTableOfTheirDecimation) {
+// The region scans' sightings take the error model of their decimation, the whole-frame scans'
+// that of theirs (quads found at full resolution have better corners).
+TEST(RobotDetectionStageTest, RegionScansTakeTheErrorModelOfTheirDecimation) {
   RobotDetectionOptions o = DetectionOptions();
   o.detector.decimate = 2.0;
   o.every_nth_frame = 2;
   o.roi_every_nth_frame = 1;
-  RobotDetectionOptions full = o;
-  full.detector.decimate = 1.0;
-  RobotDetectionStage own(o, Table(), ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b', ModelFor(full));
-  RobotDetectionStage shared(o, Table(), ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
+  // A region model that cannot be mistaken: eq. 8.1's constant sigmas.
+  RobotDetectionOptions constant = o;
+  constant.error_model = "constant";
+  auto region = RobotDetectionStage::MakeErrorModel(constant, "", 1.0, Camera(), "detection.region_error_table");
+  ASSERT_TRUE(region.ok()) << region.status().ToString();
+  const TagCarrierTable table = Table();
+  RobotDetectionStage own(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b', *region);
+  RobotDetectionStage shared(o, table, ModelFor(o), Camera(), BodyCam(), "hexacopter", 'b');
   const cv::Mat image = testing::RenderTag(10, 0.16, TagInView(4.0, 20 * kDeg), Pinhole());
   std::vector<TagSighting> a, b;
   for (int64_t t : {0, 100'000'000}) {  // whole, then region
@@ -255,7 +259,12 @@ TEST(RobotDetectionStageTest, RegionScansTakeTheErrorTableOfTheirDecimation) {
   ASSERT_EQ(b.size(), 2u);
   EXPECT_EQ(own.report().region_scans, 1u);
   EXPECT_TRUE(a[0].detection.covariance.isApprox(b[0].detection.covariance));
-  EXPECT_LT(a[1].detection.covariance.trace(), 0.8 * b[1].detection.covariance.trace());
+  EXPECT_TRUE(b[1].detection.covariance.isApprox(b[0].detection.covariance, 0.05));  // the same quad, the same model
+  Eigen::Matrix<double, 6, 1> sigma2;
+  sigma2 << 1e-4, 1e-4, 1e-4, 5e-4, 5e-4, 5e-4;
+  const Matrix6d expected =
+      RobotDetectionStage::CarrierCovariance(sigma2.asDiagonal(), table.Find(10)->T_carrier_tag.inverse());
+  EXPECT_TRUE(a[1].detection.covariance.isApprox(expected, 1e-9)) << a[1].detection.covariance;
 }
 
 // Where the graph would place a carrier whose tag `id` the camera sees at T_cam_tag, its place
