@@ -413,6 +413,7 @@ int Cairnd::Run() {
 
   notifier.Stopping();
   for (auto& s : sources_) s->Stop();
+  if (stamper) run.trigger_stamping = stamper->counts();
   pipeline.StopAndDrain();  // with a team: lingers until the teammates hold the same logs
   if (comms) {
     comms->Stop();

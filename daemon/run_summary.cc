@@ -61,6 +61,15 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
   j.Key("dropped").BeginObject();
   for (const QueueReport& q : p.queue_reports()) j.Field(q.name, q.dropped);
   j.EndObject();
+  if (run.trigger_stamping) {
+    const TriggerFrameStamperCounts& t = *run.trigger_stamping;
+    j.Key("trigger_stamping").BeginObject();
+    j.Field("edges", t.edges).Field("stamped_frames", t.stamped).Field("unmatched_frames", t.unmatched);
+    j.Field("edges_without_frame", t.lonely_edges).Field("delay_relearned", t.relearns);
+    j.Field("delay_learned", t.delay_learned);
+    if (t.delay_learned) j.Field("delay_s", t.delay);
+    j.EndObject();
+  }
   if (run.recording) {
     j.Key("recording").BeginObject();
     j.Key("files").BeginArray();

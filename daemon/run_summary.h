@@ -10,6 +10,7 @@
 #include "daemon/heap_policy.h"
 #include "daemon/pipeline/pipeline.h"
 #include "daemon/pipeline/telemetry_stage.h"
+#include "drivers/trigger_frame_stamper.h"
 
 namespace cairn {
 
@@ -31,6 +32,8 @@ struct RunInfo {
   std::optional<ReplayInfo> replay;
   std::optional<RecordingReport> recording;
   std::optional<LiveStreamReport> live;
+  // Live cameras on a trigger line: how their frames found their edges.
+  std::optional<TriggerFrameStamperCounts> trigger_stamping;
   uint64_t telemetry_dropped = 0;
   uint64_t image_codec_failures = 0;  // images the PNG/JPEG encoder refused (recording or live)
   std::vector<ExecutorReport> extra_executors;  // executors outside the pipeline (telemetry, comms)
