@@ -139,7 +139,10 @@ bool ParseSgmOptions(const ArgMap& a, SgmOptions* o) {
   if (a.Has("--fill")) o->fill_holes = true;
   for (const auto& [key, field] : {std::pair<const char*, int64_t*>{"--p1", &o->p1},
                                    {"--p2", &o->p2}, {"--uniqueness", &o->uniqueness_percent},
-                                   {"--speckle-size", &o->speckle_max_size}}) {
+                                   {"--speckle-size", &o->speckle_max_size},
+                                   {"--speckle-range", &o->speckle_max_diff},
+                                   {"--lr-max-diff", &o->lr_max_diff},
+                                   {"--p2-intensity-scale", &o->p2_intensity_scale}}) {
     if (a.Get(key).empty()) continue;
     long v = 0;
     if (!ParseInt(a.Get(key), key, &v)) return false;
@@ -176,12 +179,13 @@ int RunStereo(const CommandArgs& args) {
       "[--paths 4|8|raster4] --out DISP.pfm [--png VIS.png] [--threads T] "
       "[--backend simd|scalar|fpga-sim] "
       "[--census WxH] [--fill] [--matcher sgm|opencv-3way|opencv-hh4] [--p1 P] [--p2 P] "
-      "[--uniqueness PERCENT] [--speckle-size PIXELS] [--bidirectional]\n";
+      "[--uniqueness PERCENT] [--speckle-size PIXELS] [--speckle-range SIXTEENTHS] "
+      "[--lr-max-diff PX] [--p2-intensity-scale GRAY] [--bidirectional]\n";
   if (WantsHelp(args)) return PrintUsage(usage);
   const ArgMap a(args,
                  {"--max-disparity", "--min-disparity", "--calib", "--paths", "--out", "--png",
                   "--threads", "--backend", "--census", "--matcher", "--p1", "--p2", "--uniqueness",
-                  "--speckle-size"},
+                  "--speckle-size", "--speckle-range", "--lr-max-diff", "--p2-intensity-scale"},
                  {"--fill", "--bidirectional"});
   if (!a.error.empty() || a.positional.size() != 2 || a.Get("--out").empty() ||
       a.Get("--max-disparity").empty()) {
@@ -310,7 +314,8 @@ int RunBenchStereo(const CommandArgs& args) {
   const ArgMap a(args,
                  {"--left", "--right", "--size", "--max-disparity", "--min-disparity", "--paths",
                   "--threads", "--iterations", "--backend", "--census", "--p1", "--p2",
-                  "--uniqueness", "--speckle-size"},
+                  "--uniqueness", "--speckle-size", "--speckle-range", "--lr-max-diff",
+                  "--p2-intensity-scale"},
                  {});
   if (!a.error.empty() || !a.positional.empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
