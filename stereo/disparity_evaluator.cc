@@ -152,7 +152,7 @@ Expected<DisparityScore> DisparityEvaluator::Score(const FloatImage& estimate,
     case DisparityMetric::kBad4: threshold = 4.0; break;
     case DisparityMetric::kD1: threshold = 3.0; break;
   }
-  long bad_nonocc = 0, bad_all = 0, valid = 0;
+  long bad_nonocc = 0, bad_all = 0, valid = 0, bad_estimated = 0;
   for (size_t i = 0; i < truth.data.size(); ++i) {
     const float e = estimate.data[i];
     if (std::isfinite(e)) ++valid;
@@ -169,11 +169,18 @@ Expected<DisparityScore> DisparityEvaluator::Score(const FloatImage& estimate,
     if (mv == 255.0f) {
       ++score.scored_nonocc;
       bad_nonocc += bad;
+      if (std::isfinite(e)) {
+        ++score.estimated_nonocc;
+        bad_estimated += bad;
+      }
     }
   }
   score.bad_all = score.scored_all > 0 ? static_cast<double>(bad_all) / score.scored_all : 0.0;
   score.bad_nonocc =
       score.scored_nonocc > 0 ? static_cast<double>(bad_nonocc) / score.scored_nonocc : 0.0;
+  score.bad_estimated = score.estimated_nonocc > 0
+                            ? static_cast<double>(bad_estimated) / score.estimated_nonocc
+                            : 0.0;
   score.density = truth.data.empty() ? 0.0 : static_cast<double>(valid) / truth.data.size();
   return score;
 }

@@ -20,8 +20,12 @@ struct DisparityScore {
   double bad_nonocc = 0.0;  // fraction of scored non-occluded pixels that are bad
   double bad_all = 0.0;     // fraction of all pixels with ground truth that are bad
   double density = 0.0;     // fraction of image pixels with an estimate
+  // Fraction of the scored non-occluded pixels with an estimate that are bad: how often a depth
+  // that is given is wrong (a phantom obstacle in a map), which counting holes as bad hides.
+  double bad_estimated = 0.0;
   long scored_nonocc = 0;
   long scored_all = 0;
+  long estimated_nonocc = 0;  // scored non-occluded pixels with an estimate
   bool mask_derived = false;  // non-occluded mask computed from the ground truth itself
 };
 

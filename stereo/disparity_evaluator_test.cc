@@ -84,6 +84,22 @@ TEST(DisparityEvaluatorTest, CountsBadAndMissingPixels) {
   EXPECT_DOUBLE_EQ(s->bad_all, 0.5);
 }
 
+TEST(DisparityEvaluatorTest, ScoresTheGivenEstimatesApartFromTheMissingOnes) {
+  FloatImage truth{5, 1, {10.0f, 10.0f, 10.0f, 10.0f, 10.0f}};
+  FloatImage estimate{5, 1, {10.0f, 13.0f, kInf, kInf, 10.5f}};
+  FloatImage mask{5, 1, {255.0f, 255.0f, 255.0f, 255.0f, 128.0f}};
+  auto s = DisparityEvaluator::Score(estimate, truth, mask, DisparityMetric::kBad1);
+  ASSERT_TRUE(s.ok());
+  EXPECT_DOUBLE_EQ(s->bad_nonocc, 0.75);  // one wrong, two missing of four
+  EXPECT_EQ(s->estimated_nonocc, 2);      // the occluded pixel does not count
+  EXPECT_DOUBLE_EQ(s->bad_estimated, 0.5);
+  s = DisparityEvaluator::Score(FloatImage{5, 1, std::vector<float>(5, kInf)}, truth, mask,
+                                DisparityMetric::kBad1);
+  ASSERT_TRUE(s.ok());
+  EXPECT_EQ(s->estimated_nonocc, 0);
+  EXPECT_DOUBLE_EQ(s->bad_estimated, 0.0);
+}
+
 TEST(DisparityEvaluatorTest, RejectsSizeMismatchAndUnknownMetric) {
   FloatImage a{2, 2, {1, 1, 1, 1}}, b{2, 1, {1, 1}};
   EXPECT_FALSE(DisparityEvaluator::Score(a, b, FloatImage{}, DisparityMetric::kBad1).ok());

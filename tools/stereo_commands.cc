@@ -298,10 +298,10 @@ int RunStereoEval(const CommandArgs& args) {
   if (!filled.ok()) return Fail(filled.status());
   std::printf(
       "{\"metric\": \"%s\", \"bad_nonocc\": %.6f, \"bad_all\": %.6f, \"bad_nonocc_interpolated\": %.6f, "
-      "\"bad_all_interpolated\": %.6f, \"density\": %.6f, "
+      "\"bad_all_interpolated\": %.6f, \"bad_estimated\": %.6f, \"density\": %.6f, "
       "\"scored_nonocc\": %ld, \"scored_all\": %ld, \"nonocc_mask\": \"%s\"}\n",
       DisparityMetricName(*metric), score->bad_nonocc, score->bad_all, filled->bad_nonocc, filled->bad_all,
-      score->density, score->scored_nonocc, score->scored_all, score->mask_derived ? "derived" : "file");
+      score->bad_estimated, score->density, score->scored_nonocc, score->scored_all, score->mask_derived ? "derived" : "file");
   return 0;
 }
 
