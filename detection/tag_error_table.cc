@@ -64,7 +64,7 @@ Expected<TagErrorTable> TagErrorTable::Parse(const std::string& text, const std:
     if (!magic) {
       int version = 0;
       if (key != kMagic || !(words >> version))
-        return InvalidArgumentError(at + ": not a tag error table (expected '" + kMagic + " 1')");
+        return InvalidArgumentError(at + ": not a tag error table (expected '" + kMagic + " 2')");
       if (version == 1)
         return InvalidArgumentError(at + ": version 1 tables do not say which detector decimation they were built for; "
                                          "rebuild it with cairn detect build-lut");
