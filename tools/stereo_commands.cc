@@ -67,6 +67,15 @@ struct ArgMap {
   }
 };
 
+// The matcher's options that ParseSgmOptions reads, taken by `cairn stereo` and `cairn bench stereo` alike.
+std::vector<std::string> WithSgmKeys(std::vector<std::string> keys) {
+  for (const char* k : {"--max-disparity", "--min-disparity", "--paths", "--threads", "--backend", "--census", "--p1",
+                        "--p2", "--uniqueness", "--speckle-size", "--speckle-range", "--lr-max-diff",
+                        "--p2-intensity-scale"})
+    keys.emplace_back(k);
+  return keys;
+}
+
 bool ParseInt(const std::string& text, const std::string& what, long* out) {
   char* end = nullptr;
   const long v = std::strtol(text.c_str(), &end, 10);
@@ -182,11 +191,7 @@ int RunStereo(const CommandArgs& args) {
       "[--uniqueness PERCENT] [--speckle-size PIXELS] [--speckle-range SIXTEENTHS] "
       "[--lr-max-diff PX] [--p2-intensity-scale GRAY] [--bidirectional]\n";
   if (WantsHelp(args)) return PrintUsage(usage);
-  const ArgMap a(args,
-                 {"--max-disparity", "--min-disparity", "--calib", "--paths", "--out", "--png",
-                  "--threads", "--backend", "--census", "--matcher", "--p1", "--p2", "--uniqueness",
-                  "--speckle-size", "--speckle-range", "--lr-max-diff", "--p2-intensity-scale"},
-                 {"--fill", "--bidirectional"});
+  const ArgMap a(args, WithSgmKeys({"--calib", "--out", "--png", "--matcher"}), {"--fill", "--bidirectional"});
   if (!a.error.empty() || a.positional.size() != 2 || a.Get("--out").empty() ||
       a.Get("--max-disparity").empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
@@ -311,12 +316,7 @@ constexpr const char* kBenchStereoUsage =
 
 int RunBenchStereo(const CommandArgs& args) {
   if (WantsHelp(args)) return PrintUsage(kBenchStereoUsage);
-  const ArgMap a(args,
-                 {"--left", "--right", "--size", "--max-disparity", "--min-disparity", "--paths",
-                  "--threads", "--iterations", "--backend", "--census", "--p1", "--p2",
-                  "--uniqueness", "--speckle-size", "--speckle-range", "--lr-max-diff",
-                  "--p2-intensity-scale"},
-                 {});
+  const ArgMap a(args, WithSgmKeys({"--left", "--right", "--size", "--iterations"}), {});
   if (!a.error.empty() || !a.positional.empty()) {
     if (!a.error.empty()) std::fprintf(stderr, "cairn: %s\n", a.error.c_str());
     std::fputs(kBenchStereoUsage, stderr);
