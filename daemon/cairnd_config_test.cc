@@ -61,11 +61,11 @@ TEST(EarlierRunConfigTest, LoadsWithDefaultsAndNotesTheDifferences) {
   std::stringstream text;
   text << in.rdbuf();
   std::string yaml = text.str();
-  const std::string dof = "  dof: 4", ncc = "    min_match_ncc:";
+  const std::string dof = "  dof: 4", ncc = "\n    min_match_ncc:";  // the matcher's own, not a section's
   ASSERT_NE(yaml.find(dof), std::string::npos);
   ASSERT_NE(yaml.find(ncc), std::string::npos);
   yaml.erase(yaml.find(dof), yaml.find('\n', yaml.find(dof)) - yaml.find(dof) + 1);
-  yaml.replace(yaml.find(ncc), ncc.size(), "    old_match_ncc:");
+  yaml.replace(yaml.find(ncc), ncc.size(), "\n    old_match_ncc:");
   const std::string path = testing::FreshTempDir("earlier_config") + "/config.yaml";
   std::ofstream(path) << yaml;
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/elapsed.h"
+#include "mapping/matching/grey_level_search.h"
 #include "mapping/matching/six_dof_icp.h"
 #include "mapping/matching/six_dof_ransac.h"
 
@@ -189,8 +190,6 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   const HoughResult votes = HoughVoting(options_.hough).Vote(a.described, b.described, correspondences);
   r.clusters = votes.clusters.size();
   r.times.hough_ms = MillisecondsSince(stage);
-  if (votes.clusters.empty())
-    return finish(MatchStatus::kNoMatch, Format("%zu correspondences, no vote cluster", correspondences.size()));
 
   // One RANSAC per cluster; gate and spread checks per hypothesis.
   stage = Clock::now();
@@ -296,19 +295,17 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     hypotheses.push_back(std::move(h));
   }
   r.times.ransac_ms = MillisecondsSince(stage);
-  if (hypotheses.empty())
-    return finish(MatchStatus::kNoMatch, rejections.Summary("no cluster reached a RANSAC consensus"));
+  if (votes.clusters.empty())
+    rejections.Add("no vote cluster", Format("%zu correspondences, no vote cluster", correspondences.size()));
   std::stable_sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& x, const Hypothesis& y) {
     return x.inliers > y.inliers || (x.inliers == y.inliers && x.rms < y.rms);
   });
 
-  // Refinement on the full clouds.
+  // Refinement on the full clouds; true when `h` became the match.
   stage = Clock::now();
   const FourDofIcp icp(options_.icp);
   const SixDofIcp icp6(options_.icp);
-  const size_t tries = std::min(hypotheses.size(), static_cast<size_t>(options_.max_refined_hypotheses));
-  for (size_t k = 0; k < tries; ++k) {
-    const Hypothesis& h = hypotheses[k];
+  const auto Refined = [&](const Hypothesis& h, std::string_view source, double min_match_ncc) {
     ++r.refined;
     const Refinement fit = six ? Refine6(icp6, a, b, h) : Refine4(icp, a, b, h);
     r.icp_inliers = fit.inliers;
@@ -317,7 +314,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     r.ransac_inliers = h.inliers;
     if (!fit.status.ok()) {
       rejections.Add("refinements failed", fit.status.message());
-      continue;
+      return false;
     }
     std::string why;
     if (fit.shift > options_.max_refinement_translation || fit.turn > options_.max_refinement_yaw) {
@@ -331,8 +328,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
                                                           static_cast<long long>(options_.min_icp_inliers)));
     } else if (prior.has_value() && !WithinGate(fit.T_a_b, *prior, &why)) {
       rejections.Add("refinements outside the gate", "refined match " + why);
-    } else if (const Verdict grey = six ? Judge(options_.min_match_ncc, fit.T_full, &why)
-                                        : Judge(options_.min_match_ncc, fit.T_a_b, &why);
+    } else if (const Verdict grey = six ? Judge(min_match_ncc, fit.T_full, &why) : Judge(min_match_ncc, fit.T_a_b, &why);
                grey == Verdict::kDisagree) {
       ++r.photometric_rejected;
       r.photometric = last_grey;
@@ -348,15 +344,68 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       r.covariance = fit.covariance;
       const double ft = options_.covariance_floor_translation, fy = options_.covariance_floor_yaw;
       r.covariance.diagonal() += Eigen::Vector4d(ft * ft, ft * ft, ft * ft, fy * fy);
+      r.status = MatchStatus::kMatched;
+      r.reason = std::string(source) + Format("; icp %zu pairs, rms %.4f m", fit.inliers, fit.rms) +
+                 (grey == Verdict::kAgree ? Format("; grey levels correlate %.3f", r.photometric.ncc)
+                                          : "; " + why + ": geometry only");
+      return true;
+    }
+    return false;
+  };
+  const size_t tries = std::min(hypotheses.size(), static_cast<size_t>(options_.max_refined_hypotheses));
+  for (size_t k = 0; k < tries; ++k) {
+    const Hypothesis& h = hypotheses[k];
+    if (Refined(h, Format("%zu RANSAC inliers of %zu correspondences", h.inliers, correspondences.size()),
+                options_.min_match_ncc)) {
       r.times.icp_ms = MillisecondsSince(stage);
-      return finish(MatchStatus::kMatched,
-                    Format("%zu RANSAC inliers of %zu correspondences; icp %zu pairs, rms %.4f m", h.inliers,
-                           correspondences.size(), fit.inliers, fit.rms) +
-                        (grey == Verdict::kAgree ? Format("; grey levels correlate %.3f", r.photometric.ncc)
-                                                 : "; " + why + ": geometry only"));
+      return finish(MatchStatus::kMatched, r.reason);
     }
   }
   r.times.icp_ms = MillisecondsSince(stage);
+
+  // Where the descriptors gave no hypothesis that held, the grey levels seen from above are
+  // searched for one (4-DoF only: the search turns about gravity).
+  if (!six && options_.grey_search.enabled) {
+    stage = Clock::now();
+    // With a relative estimate, only the yaws its gate admits.
+    Eigen::Vector2d yaw_window(0.0, 4.0);
+    if (prior.has_value()) {
+      const double sigma = std::sqrt(std::max(prior->covariance(3, 3), 0.0));
+      yaw_window = {prior->T_a_b.yaw(), std::max(options_.gate_sigmas * sigma, options_.gate_floor_yaw)};
+    }
+    Expected<GreyLevelSearchResult> found = GreyLevelSearch(options_.grey_search)
+                                                .Search(a.cloud, a.cloud_grey, b.cloud, b.cloud_grey, yaw_window);
+    r.times.search_ms = MillisecondsSince(stage);
+    if (!found.ok()) {
+      rejections.Add("grey-level search refused", found.status().message());
+    } else {
+      if (found->candidates.empty()) rejections.Add("grey-level search without a candidate", "grey-level search: no candidate");
+      for (const GreyLevelCandidate& candidate : found->candidates) {
+        ++r.searched;
+        Hypothesis h;
+        h.T_a_b = candidate.T_a_b;
+        h.T_full = h.T_a_b.ToIsometry();
+        std::string why;
+        if (prior.has_value() && !WithinGate(h.T_a_b, *prior, &why)) {
+          rejections.Add("searched candidates outside the gate", "searched candidate " + why);
+          continue;
+        }
+        // Found by the grey levels, so only they can vouch for it: undecided is refused too.
+        if (Judge(options_.min_hypothesis_ncc, h.T_a_b, &why) != Verdict::kAgree) {
+          rejections.Add("searched candidates whose grey levels disagree", "searched candidate: " + why);
+          continue;
+        }
+        h.grey_agreed = true;
+        const auto icp_start = Clock::now();
+        const bool matched =
+            Refined(h, Format("grey-level search, raster correlation %.3f over %lld cells", candidate.correlation,
+                              static_cast<long long>(candidate.overlap_cells)),
+                    std::max(options_.min_match_ncc, options_.grey_search.min_match_ncc));
+        r.times.icp_ms += MillisecondsSince(icp_start);
+        if (matched) return finish(MatchStatus::kMatched, r.reason);
+      }
+    }
+  }
   return finish(MatchStatus::kNoMatch, rejections.Summary("no hypothesis refined"));
 }
 

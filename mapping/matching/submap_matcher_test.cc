@@ -127,6 +127,36 @@ TEST_F(SubmapMatcherTest, AGoodRelativeEstimateKeepsTheMatch) {
   EXPECT_LT((r.T_a_b.translation() - truth.translation()).norm(), 0.05);
 }
 
+// Descriptors that yield no hypothesis (here no cluster can reach the consensus asked for) leave
+// the pair unmatched; with the grey-level search on, the ground's pattern seen from above still
+// finds the match, and the search's candidates meet the same gate.
+TEST_F(SubmapMatcherTest, TheGreyLevelSearchFindsWhatTheDescriptorsMiss) {
+  const SubmapFeatures& b = *features_b_;
+  SubmapMatcherOptions options;
+  options.ransac.min_inliers = 1'000'000;
+  const SubmapMatchResult without = SubmapMatcher(options).Match(*features_a_, b);
+  EXPECT_EQ(without.status, MatchStatus::kNoMatch) << without.reason;
+  EXPECT_EQ(without.searched, 0u);
+
+  options.grey_search.enabled = true;
+  options.grey_search.min_match_ncc = 0.9;  // this scene's true alignment correlates 0.944
+  const SubmapMatchResult r = SubmapMatcher(options).Match(*features_a_, b);
+  Print("grey-level search", r);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_GT(r.searched, 0u);
+  EXPECT_NE(r.reason.find("grey-level search"), std::string::npos) << r.reason;
+  const FourDofTransform truth = TruthOf(*pair_).T_a_b;
+  EXPECT_LT((r.T_a_b.translation() - truth.translation()).norm(), 0.05);
+  EXPECT_LT(YawError(r.T_a_b, truth), 0.5 * kDegree);
+
+  RelativePoseEstimate wrong;
+  wrong.T_a_b = FourDofTransform(truth.translation() + Eigen::Vector3d(1.5, 0.0, 0.0), truth.yaw());
+  wrong.covariance = Eigen::Vector4d(0.04, 0.04, 0.01, 0.01).asDiagonal();
+  const SubmapMatchResult gated = SubmapMatcher(options).Match(*features_a_, b, wrong);
+  EXPECT_EQ(gated.status, MatchStatus::kNoMatch);
+  EXPECT_NE(gated.reason.find("searched candidate x off the relative estimate"), std::string::npos) << gated.reason;
+}
+
 TEST_F(SubmapMatcherTest, AConfidentWrongEstimateGatesTheMatchOut) {
   RelativePoseEstimate prior;
   const FourDofTransform truth = TruthOf(*pair_).T_a_b;
