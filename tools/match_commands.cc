@@ -138,12 +138,14 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
 
 constexpr const char* kBenchMatchUsage =
     "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
-    "                         [--no-photometric] [--grey-search] [--dof 4|6]\n"
+    "                         [--no-photometric] [--no-grey-search] [--no-grey-refinement]\n"
+    "                         [--dof 4|6]\n"
     "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
     "  --wire-bits: first send every submap through the wire format at these bit counts\n"
     "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
     "  --no-photometric: geometry only, the keypoint spread check on every hypothesis (thesis 6.1)\n"
-    "  --grey-search: where the descriptors find no match, search the grey levels seen from above\n"
+    "  --no-grey-search: hypotheses from the descriptors only (no search of the grey levels from above)\n"
+    "  --no-grey-refinement: the ICP's x, y and yaw as they are (not moved to the grey levels' best)\n"
     "  --dof 6: the matcher's variant without gravity; a match must then also be level within 0.5 deg\n";
 
 int RunBenchMatch(const CommandArgs& args) {
@@ -153,7 +155,6 @@ int RunBenchMatch(const CommandArgs& args) {
   std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
   SubmapMatcherOptions matcher_options;
   ShotFrame frame = ShotFrame::kGravity;
-  bool no_photometric = false;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     std::vector<double> v;
@@ -165,9 +166,12 @@ int RunBenchMatch(const CommandArgs& args) {
       ++i;
     } else if (a == "--no-photometric") {
       matcher_options.min_hypothesis_ncc = matcher_options.min_match_ncc = -1.0;
-      no_photometric = true;
-    } else if (a == "--grey-search") {
-      matcher_options.grey_search.enabled = true;
+      matcher_options.grey_search.enabled = false;  // both need the grey levels
+      matcher_options.grey_refinement = false;
+    } else if (a == "--no-grey-search") {
+      matcher_options.grey_search.enabled = false;
+    } else if (a == "--no-grey-refinement") {
+      matcher_options.grey_refinement = false;
     } else if (a == "--dof" && i + 1 < args.args.size() &&
                (args.args[i + 1] == std::string("4") || args.args[i + 1] == std::string("6"))) {
       frame = args.args[++i] == std::string("6") ? ShotFrame::kFull : ShotFrame::kGravity;
@@ -180,10 +184,6 @@ int RunBenchMatch(const CommandArgs& args) {
   }
   if (dirs.empty()) {
     std::fprintf(stderr, "cairn bench match: name at least one cairnd output folder (e.g. out/rover)\n");
-    return 2;
-  }
-  if (no_photometric && matcher_options.grey_search.enabled) {
-    std::fprintf(stderr, "cairn bench match: --grey-search needs the grey levels that --no-photometric turns off\n");
     return 2;
   }
   std::vector<IndexedSubmap> submaps;

@@ -20,10 +20,8 @@
 namespace cairn {
 
 struct GreyLevelSearchOptions {
-  // Off: the matcher's hypotheses come from the descriptors only (the thesis' pipeline). Off by
-  // default: on missions it was not tuned on it added few matches for about 4x the time per pair
-  // (docs/results.md, Submap matching).
-  bool enabled = false;
+  // Off: the matcher's hypotheses come from the descriptors only (the thesis' pipeline).
+  bool enabled = true;
   double cell = 0.2;          // m; raster resolution
   double yaw_step = 0.052;    // rad; 3 deg: at 5 m from the origin 0.13 m off, within the ICP's reach
   double local_mean_radius = 0.4;  // m; half width of the window whose mean each cell loses

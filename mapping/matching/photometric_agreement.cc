@@ -57,4 +57,41 @@ PhotometricScore PhotometricAgreement::Score(const std::vector<Eigen::Vector3d>&
   return out;
 }
 
+FourDofTransform PhotometricAgreement::Refine(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
+                                              const FourDofTransform& start, double step_translation,
+                                              double step_yaw, int max_scores, PhotometricScore* best) const {
+  const auto Value = [](const PhotometricScore& s) { return std::isfinite(s.ncc) ? s.ncc : -2.0; };
+  FourDofTransform at = start;
+  PhotometricScore here = Score(cloud, grey, at);
+  int scores = 1;
+  double dt = step_translation, dyaw = step_yaw;
+  const double min_dt = 0.1 * step_translation, min_dyaw = 0.1 * step_yaw;
+  while (scores + 6 <= max_scores && (dt >= min_dt || dyaw >= min_dyaw)) {
+    bool moved = false;
+    static constexpr int kAxes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    FourDofTransform next = at;
+    PhotometricScore next_score = here;
+    for (const auto& axis : kAxes) {
+      const Eigen::Vector3d t = at.translation() + Eigen::Vector3d(axis[0] * dt, axis[1] * dt, 0.0);
+      const FourDofTransform trial(t, at.yaw() + axis[2] * dyaw);
+      const PhotometricScore s = Score(cloud, grey, trial);
+      ++scores;
+      if (Value(s) > Value(next_score)) {
+        next = trial;
+        next_score = s;
+        moved = true;
+      }
+    }
+    if (moved) {
+      at = next;
+      here = next_score;
+    } else {
+      dt *= 0.5;
+      dyaw *= 0.5;
+    }
+  }
+  if (best != nullptr) *best = here;
+  return at;
+}
+
 }  // namespace cairn

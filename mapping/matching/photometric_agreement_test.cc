@@ -40,6 +40,30 @@ Ground InFrameB(const Ground& a, const FourDofTransform& T_a_b) {
   return b;
 }
 
+// An alignment centimetres and degrees off (as the ICP leaves one on smooth ground) moves back to
+// the truth, to within the score's resolution (its 5 cm voxels; here every point sits at a voxel's
+// centre, so the score is flat within half a voxel); one at the truth stays there.
+TEST(PhotometricAgreementTest, RefinementMovesXYAndYawToTheBestAgreement) {
+  const Ground a = MakeGround(2);
+  const FourDofTransform truth(1.2, -0.4, 0.05, 0.6);
+  const Ground b = InFrameB(a, truth);
+  const PhotometricAgreement check(a.points, a.grey, 0.05);
+  const FourDofTransform off(truth.translation() + Eigen::Vector3d(0.09, -0.07, 0.0), truth.yaw() + 0.035);
+  PhotometricScore before = check.Score(b.points, b.grey, off), after;
+  const FourDofTransform refined = check.Refine(b.points, b.grey, off, 0.04, 0.01, 200, &after);
+  EXPECT_GT(after.ncc, before.ncc + 0.2) << before.ncc;
+  EXPECT_LT((refined.translation() - truth.translation()).head<2>().norm(), 0.03);
+  EXPECT_DOUBLE_EQ(refined.translation().z(), off.translation().z());
+  EXPECT_LT(std::abs(WrapAngle(refined.yaw() - truth.yaw())), 0.0125);
+
+  const FourDofTransform kept = check.Refine(b.points, b.grey, truth, 0.04, 0.01, 200, &after);
+  EXPECT_LT((kept.translation() - truth.translation()).norm(), 0.01);
+  EXPECT_GT(after.ncc, 0.95);
+  // The budget of scores holds: with 7 only one round of 6 neighbours is tried.
+  check.Refine(b.points, b.grey, off, 0.04, 0.01, 7, &after);
+  EXPECT_GE(after.ncc, before.ncc);
+}
+
 TEST(PhotometricAgreementTest, GreyLevelsAgreeAtTheTrueAlignmentOnly) {
   const Ground a = MakeGround(1);
   const FourDofTransform truth(1.2, -0.4, 0.05, 0.6);

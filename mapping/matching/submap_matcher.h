@@ -72,6 +72,12 @@ struct SubmapMatcherOptions {
   double min_hypothesis_ncc = 0.7;
   double min_match_ncc = 0.9;
   int64_t min_photometric_pairs = 500;
+  // After the ICP (4-DoF), x, y and yaw move to where the grey levels correlate best
+  // (PhotometricAgreement::Refine), from these steps, with at most this many scores.
+  bool grey_refinement = true;
+  double grey_refinement_step = 0.04;      // m
+  double grey_refinement_step_yaw = 0.01;  // rad
+  int64_t grey_refinement_max_scores = 80;
   // Added (as variances) to the ICP's covariance, which treats every residual as independent: the
   // errors the clouds' points share (each a centroid in a 0.05 m voxel, about 0.014 m RMS, and the
   // stereo calibration) do not average out over thousands of pairs.
@@ -98,6 +104,10 @@ struct SubmapMatcherOptions {
     v.Number("min_hypothesis_ncc", min_hypothesis_ncc, -1.0, 1.0, "correlation");
     v.Number("min_match_ncc", min_match_ncc, -1.0, 1.0, "correlation");
     v.Integer("min_photometric_pairs", min_photometric_pairs, 2, 100'000'000, "points");
+    v.Flag("grey_refinement", grey_refinement);
+    v.Number("grey_refinement_step", grey_refinement_step, 1e-4, 1.0, "m");
+    v.Number("grey_refinement_step_yaw", grey_refinement_step_yaw, 1e-5, 0.5, "rad");
+    v.Integer("grey_refinement_max_scores", grey_refinement_max_scores, 7, 100'000, "scores");
     v.Number("covariance_floor_translation", covariance_floor_translation, 0.0, 10.0, "m");
     v.Number("covariance_floor_yaw", covariance_floor_yaw, 0.0, 1.0, "rad");
   }

@@ -128,12 +128,13 @@ TEST_F(SubmapMatcherTest, AGoodRelativeEstimateKeepsTheMatch) {
 }
 
 // Descriptors that yield no hypothesis (here no cluster can reach the consensus asked for) leave
-// the pair unmatched; with the grey-level search on, the ground's pattern seen from above still
+// the pair unmatched without the grey-level search; with it (the default), the ground's pattern seen from above still
 // finds the match, and the search's candidates meet the same gate.
 TEST_F(SubmapMatcherTest, TheGreyLevelSearchFindsWhatTheDescriptorsMiss) {
   const SubmapFeatures& b = *features_b_;
   SubmapMatcherOptions options;
   options.ransac.min_inliers = 1'000'000;
+  options.grey_search.enabled = false;
   const SubmapMatchResult without = SubmapMatcher(options).Match(*features_a_, b);
   EXPECT_EQ(without.status, MatchStatus::kNoMatch) << without.reason;
   EXPECT_EQ(without.searched, 0u);
@@ -245,7 +246,8 @@ TEST(SubmapMatcherSceneTest, SubmapsFromTheWireMatchAsPreciselyAsTheOriginals) {
       ASSERT_TRUE(r.matched()) << "seed " << seed << (on_wire ? " from the wire" : "") << ": " << r.reason;
       const FourDofTransform e = truth.T_a_b.inverse() * r.T_a_b;
       EXPECT_LT(e.translation().norm(), 0.01) << "seed " << seed;
-      EXPECT_LT(YawError(r.T_a_b, truth.T_a_b), 0.1 * kDegree) << "seed " << seed;
+      // The grey-level refinement after the ICP resolves yaw to about 0.1 deg here (its 5 cm voxels).
+      EXPECT_LT(YawError(r.T_a_b, truth.T_a_b), 0.2 * kDegree) << "seed " << seed;
       sum2[on_wire] += e.translation().squaredNorm();
     }
   }
