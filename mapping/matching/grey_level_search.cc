@@ -18,77 +18,100 @@ namespace {
 // submap; the FFTs' memory grows with its square.
 constexpr int kMaxRasterCells = 2048;
 
-// Grey levels (and heights) of points turned by `yaw`, in cells of `cell` m from `origin`: the
-// local deviation of each textured cell's mean grey level (0 elsewhere) and the mask of those
-// cells.
-struct Raster {
-  cv::Mat deviation;  // CV_32F
-  cv::Mat mask;       // CV_32F, 1 where textured
-  cv::Mat height;     // CV_32F mean z, valid where mask
+// A cloud's finite points with finite grey levels, as flat arrays (filtered once, turned per yaw).
+struct GreyPoints {
+  std::vector<float> x, y, z, grey;
+  GreyPoints(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& g) {
+    const size_t n = std::min(cloud.size(), g.size());
+    for (size_t i = 0; i < n; ++i) {
+      if (!cloud[i].allFinite() || !std::isfinite(g[i])) continue;
+      x.push_back(static_cast<float>(cloud[i].x()));
+      y.push_back(static_cast<float>(cloud[i].y()));
+      z.push_back(static_cast<float>(cloud[i].z()));
+      grey.push_back(g[i]);
+    }
+  }
+  size_t size() const { return x.size(); }
 };
 
-Raster Rasterize(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey, double yaw,
-                 const Eigen::Vector2d& origin, int rows, int cols, double cell, int mean_half_width) {
-  cv::Mat sum = cv::Mat::zeros(rows, cols, CV_32F), count = cv::Mat::zeros(rows, cols, CV_32F);
-  cv::Mat z = cv::Mat::zeros(rows, cols, CV_32F);
-  const double c = std::cos(yaw), s = std::sin(yaw), inv = 1.0 / cell;
-  const size_t n = std::min(cloud.size(), grey.size());
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d& p = cloud[i];
-    if (!p.allFinite() || !std::isfinite(grey[i])) continue;
-    const double x = c * p.x() - s * p.y() - origin.x(), y = s * p.x() + c * p.y() - origin.y();
-    const double fc = std::floor(x * inv), fr = std::floor(y * inv);
-    if (!(fc >= 0.0 && fr >= 0.0 && fc < cols && fr < rows)) continue;
-    const int col = static_cast<int>(fc), row = static_cast<int>(fr);
-    sum.at<float>(row, col) += grey[i];
-    count.at<float>(row, col) += 1.0f;
-    z.at<float>(row, col) += static_cast<float>(p.z());
+// Grey levels (and heights) of points turned by a yaw, in cells of `cell` m from an origin: the
+// local deviation of each textured cell's mean grey level (0 elsewhere), its square, the mask of
+// those cells and their mean heights. The buffers are reused from one yaw to the next.
+class Raster {
+ public:
+  Raster(int rows, int cols, double cell, int mean_half_width)
+      : rows_(rows), cols_(cols), inverse_cell_(1.0 / cell), window_(2 * mean_half_width + 1, 2 * mean_half_width + 1) {
+    for (cv::Mat* m : {&sum_, &count_, &z_, &mean_, &deviation, &deviation_sq, &mask, &height})
+      m->create(rows, cols, CV_32F);
   }
-  Raster r;
-  r.mask = cv::Mat::zeros(rows, cols, CV_32F);
-  cv::Mat mean = cv::Mat::zeros(rows, cols, CV_32F);
-  r.height = cv::Mat::zeros(rows, cols, CV_32F);
-  for (int row = 0; row < rows; ++row) {
-    for (int col = 0; col < cols; ++col) {
-      const float k = count.at<float>(row, col);
-      if (k <= 0.0f) continue;
-      r.mask.at<float>(row, col) = 1.0f;
-      mean.at<float>(row, col) = sum.at<float>(row, col) / k;
-      r.height.at<float>(row, col) = z.at<float>(row, col) / k;
+
+  void Fill(const GreyPoints& points, double yaw, const Eigen::Vector2d& origin) {
+    sum_.setTo(0.0f);
+    count_.setTo(0.0f);
+    z_.setTo(0.0f);
+    const float c = static_cast<float>(std::cos(yaw)), s = static_cast<float>(std::sin(yaw));
+    const float ox = static_cast<float>(origin.x()), oy = static_cast<float>(origin.y());
+    const float inv = static_cast<float>(inverse_cell_);
+    float* sum = sum_.ptr<float>();
+    float* count = count_.ptr<float>();
+    float* z = z_.ptr<float>();
+    for (size_t i = 0; i < points.size(); ++i) {
+      const float fc = std::floor((c * points.x[i] - s * points.y[i] - ox) * inv);
+      const float fr = std::floor((s * points.x[i] + c * points.y[i] - oy) * inv);
+      if (!(fc >= 0.0f && fr >= 0.0f && fc < static_cast<float>(cols_) && fr < static_cast<float>(rows_))) continue;
+      const size_t k = static_cast<size_t>(fr) * static_cast<size_t>(cols_) + static_cast<size_t>(fc);
+      sum[k] += points.grey[i];
+      count[k] += 1.0f;
+      z[k] += points.z[i];
+    }
+    const size_t n = static_cast<size_t>(rows_) * static_cast<size_t>(cols_);
+    float* m = mask.ptr<float>();
+    float* mean = mean_.ptr<float>();
+    float* h = height.ptr<float>();
+    for (size_t k = 0; k < n; ++k) {
+      const bool known = count[k] > 0.0f;
+      m[k] = known ? 1.0f : 0.0f;
+      mean[k] = known ? sum[k] / count[k] : 0.0f;
+      h[k] = known ? z[k] / count[k] : 0.0f;
+    }
+    // Local mean over the textured cells of the window (sum_ and count_ are free again).
+    cv::boxFilter(mean_, sum_, CV_32F, window_, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+    cv::boxFilter(mask, count_, CV_32F, window_, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+    float* d = deviation.ptr<float>();
+    float* d2 = deviation_sq.ptr<float>();
+    for (size_t k = 0; k < n; ++k) {
+      d[k] = m[k] != 0.0f ? mean[k] - sum[k] / count[k] : 0.0f;
+      d2[k] = d[k] * d[k];
     }
   }
-  // Local mean over the textured cells of a (2w+1)^2 window.
-  cv::Mat local_sum, local_count;
-  const cv::Size window(2 * mean_half_width + 1, 2 * mean_half_width + 1);
-  cv::boxFilter(mean, local_sum, CV_32F, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-  cv::boxFilter(r.mask, local_count, CV_32F, window, cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
-  r.deviation = cv::Mat::zeros(rows, cols, CV_32F);
-  for (int row = 0; row < rows; ++row) {
-    for (int col = 0; col < cols; ++col) {
-      if (r.mask.at<float>(row, col) == 0.0f) continue;
-      r.deviation.at<float>(row, col) =
-          mean.at<float>(row, col) - local_sum.at<float>(row, col) / local_count.at<float>(row, col);
-    }
+
+  cv::Mat deviation, deviation_sq, mask, height;  // CV_32F
+
+ private:
+  int rows_, cols_;
+  double inverse_cell_;
+  cv::Size window_;
+  cv::Mat sum_, count_, z_, mean_;
+};
+
+// Forward DFTs (packed) of rasters placed at the top left of a zero matrix of the padded size,
+// and correlations of two spectra, with buffers reused from one yaw to the next.
+class Spectra {
+ public:
+  Spectra(int rows, int cols) : padded_(cv::Mat::zeros(rows, cols, CV_32F)) {}
+  void Forward(const cv::Mat& m, cv::Mat& spectrum) {
+    m.copyTo(padded_(cv::Rect(0, 0, m.cols, m.rows)));
+    cv::dft(padded_, spectrum, 0, m.rows);
   }
-  return r;
-}
+  // sum_x a(x + s) b(x) for every circular shift s.
+  void Correlate(const cv::Mat& spectrum_a, const cv::Mat& spectrum_b, cv::Mat& out) {
+    cv::mulSpectrums(spectrum_a, spectrum_b, product_, 0, true);
+    cv::idft(product_, out, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+  }
 
-// The forward DFT (packed) of `m` placed at the top left of a zero `rows` x `cols` matrix.
-cv::Mat PaddedSpectrum(const cv::Mat& m, int rows, int cols) {
-  cv::Mat padded = cv::Mat::zeros(rows, cols, CV_32F);
-  m.copyTo(padded(cv::Rect(0, 0, m.cols, m.rows)));
-  cv::Mat spectrum;
-  cv::dft(padded, spectrum, 0, m.rows);
-  return spectrum;
-}
-
-// sum_x a(x + s) b(x) for every circular shift s.
-cv::Mat Correlate(const cv::Mat& spectrum_a, const cv::Mat& spectrum_b) {
-  cv::Mat product, out;
-  cv::mulSpectrums(spectrum_a, spectrum_b, product, 0, true);
-  cv::idft(product, out, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
-  return out;
-}
+ private:
+  cv::Mat padded_, product_;
+};
 
 struct SearchPeak {
   int yaw_index = 0;
@@ -126,7 +149,7 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
   const Eigen::Vector2d centre_b = box_b.center();
   double radius_b = 0.0;
   for (size_t i = 0; i < std::min(cloud_b.size(), grey_b.size()); ++i)
-    if (cloud_b[i].allFinite()) radius_b = std::max(radius_b, (cloud_b[i].head<2>() - centre_b).norm());
+    if (cloud_b[i].allFinite() && std::isfinite(grey_b[i])) radius_b = std::max(radius_b, (cloud_b[i].head<2>() - centre_b).norm());
   const int cols_a = static_cast<int>(std::ceil(box_a.sizes().x() / o.cell)) + 1;
   const int rows_a = static_cast<int>(std::ceil(box_a.sizes().y() / o.cell)) + 1;
   const int side_b = static_cast<int>(std::ceil(2.0 * radius_b / o.cell)) + 1;
@@ -135,15 +158,22 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
                                 " cells per side, more than " + std::to_string(kMaxRasterCells));
   const int half_width = static_cast<int>(std::lround(o.local_mean_radius / o.cell));
   const Eigen::Vector2d origin_a = box_a.min();
-  const Raster ra = Rasterize(cloud_a, grey_a, 0.0, origin_a, rows_a, cols_a, o.cell, half_width);
+  const GreyPoints points_a(cloud_a, grey_a), points_b(cloud_b, grey_b);
+  Raster ra(rows_a, cols_a, o.cell, half_width);
+  ra.Fill(points_a, 0.0, origin_a);
 
   // Linear (not circular) correlation: every shift from -(side_b - 1) to size_a - 1.
   const int rows = cv::getOptimalDFTSize(rows_a + side_b - 1), cols = cv::getOptimalDFTSize(cols_a + side_b - 1);
-  cv::Mat a_dev_sq;
-  cv::multiply(ra.deviation, ra.deviation, a_dev_sq);
-  const cv::Mat fa = PaddedSpectrum(ra.deviation, rows, cols);
-  const cv::Mat fa_sq = PaddedSpectrum(a_dev_sq, rows, cols);
-  const cv::Mat fa_mask = PaddedSpectrum(ra.mask, rows, cols);
+  cv::Mat fa, fa_sq, fa_mask;
+  {
+    Spectra spectra_a(rows, cols);
+    spectra_a.Forward(ra.deviation, fa);
+    spectra_a.Forward(ra.deviation_sq, fa_sq);
+    spectra_a.Forward(ra.mask, fa_mask);
+  }
+  Spectra spectra(rows, cols);
+  Raster rb(side_b, side_b, o.cell, half_width);
+  cv::Mat fb, fb_sq, fb_mask, overlap, ab, aa, bb;
 
   const int yaws = static_cast<int>(std::ceil(2.0 * std::numbers::pi / o.yaw_step));
   const double step = 2.0 * std::numbers::pi / yaws;
@@ -156,23 +186,25 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
     ++out.yaws;
     const Eigen::Vector2d turned_centre = Eigen::Rotation2Dd(yaw) * centre_b;
     const Eigen::Vector2d origin_b = turned_centre - Eigen::Vector2d::Constant(radius_b);
-    const Raster rb = Rasterize(cloud_b, grey_b, yaw, origin_b, side_b, side_b, o.cell, half_width);
-    cv::Mat b_dev_sq;
-    cv::multiply(rb.deviation, rb.deviation, b_dev_sq);
-    const cv::Mat fb = PaddedSpectrum(rb.deviation, rows, cols);
-    const cv::Mat fb_sq = PaddedSpectrum(b_dev_sq, rows, cols);
-    const cv::Mat fb_mask = PaddedSpectrum(rb.mask, rows, cols);
-    const cv::Mat overlap = Correlate(fa_mask, fb_mask);
-    const cv::Mat ab = Correlate(fa, fb);
-    const cv::Mat aa = Correlate(fa_sq, fb_mask);
-    const cv::Mat bb = Correlate(fa_mask, fb_sq);
-    score.setTo(-2.0f);
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < cols; ++c) {
-        if (overlap.at<float>(r, c) < static_cast<float>(o.min_overlap_cells) - 0.5f) continue;
-        const double d = static_cast<double>(aa.at<float>(r, c)) * bb.at<float>(r, c);
-        if (!(d > 1e-12)) continue;
-        score.at<float>(r, c) = static_cast<float>(ab.at<float>(r, c) / std::sqrt(d));
+    rb.Fill(points_b, yaw, origin_b);
+    spectra.Forward(rb.deviation, fb);
+    spectra.Forward(rb.deviation_sq, fb_sq);
+    spectra.Forward(rb.mask, fb_mask);
+    spectra.Correlate(fa_mask, fb_mask, overlap);
+    spectra.Correlate(fa, fb, ab);
+    spectra.Correlate(fa_sq, fb_mask, aa);
+    spectra.Correlate(fa_mask, fb_sq, bb);
+    {
+      const size_t n = static_cast<size_t>(rows) * static_cast<size_t>(cols);
+      const float* ov = overlap.ptr<float>();
+      const float* pab = ab.ptr<float>();
+      const float* paa = aa.ptr<float>();
+      const float* pbb = bb.ptr<float>();
+      float* ps = score.ptr<float>();
+      const float min_overlap = static_cast<float>(o.min_overlap_cells) - 0.5f;
+      for (size_t i = 0; i < n; ++i) {
+        const double d = static_cast<double>(paa[i]) * pbb[i];
+        ps[i] = ov[i] >= min_overlap && d > 1e-12 ? static_cast<float>(pab[i] / std::sqrt(d)) : -2.0f;
       }
     }
     // The best few peaks of this yaw, each suppressing its neighbourhood.
@@ -223,7 +255,7 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
   for (const SearchPeak& p : kept) {
     const Eigen::Vector2d turned_centre = Eigen::Rotation2Dd(p.yaw) * centre_b;
     const Eigen::Vector2d origin_b = turned_centre - Eigen::Vector2d::Constant(radius_b);
-    const Raster rb = Rasterize(cloud_b, grey_b, p.yaw, origin_b, side_b, side_b, o.cell, half_width);
+    rb.Fill(points_b, p.yaw, origin_b);
     const int sr = static_cast<int>(std::lround(p.shift.y())), sc = static_cast<int>(std::lround(p.shift.x()));
     dz.clear();
     for (int r = 0; r < side_b; ++r) {
