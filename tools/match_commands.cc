@@ -366,7 +366,10 @@ int RunMatch(const CommandArgs& args) {
   j.Key("time_ms").BeginObject();
   j.Field("keypoints", fa.keypoint_ms + fb.keypoint_ms).Field("descriptors", fa.descriptor_ms + fb.descriptor_ms);
   j.Field("correspondences", r.times.correspondences_ms).Field("hough", r.times.hough_ms);
-  j.Field("ransac", r.times.ransac_ms).Field("icp", r.times.icp_ms).Field("search", r.times.search_ms).Field("match_total", r.times.total_ms);
+  j.Field("ransac", r.times.ransac_ms)
+      .Field("icp", r.times.icp_ms)
+      .Field("search", r.times.search_ms)
+      .Field("match_total", r.times.total_ms);
   j.EndObject();
   j.EndObject();
   std::printf("%s\n", j.str().c_str());

@@ -40,7 +40,10 @@ struct GreyPoints {
 class Raster {
  public:
   Raster(int rows, int cols, double cell, int mean_half_width)
-      : rows_(rows), cols_(cols), inverse_cell_(1.0 / cell), window_(2 * mean_half_width + 1, 2 * mean_half_width + 1) {
+      : rows_(rows),
+        cols_(cols),
+        inverse_cell_(1.0 / cell),
+        window_(2 * mean_half_width + 1, 2 * mean_half_width + 1) {
     for (cv::Mat* m : {&sum_, &count_, &z_, &mean_, &deviation, &deviation_sq, &mask, &height})
       m->create(rows, cols, CV_32F);
   }
@@ -58,7 +61,8 @@ class Raster {
     for (size_t i = 0; i < points.size(); ++i) {
       const float fc = std::floor((c * points.x[i] - s * points.y[i] - ox) * inv);
       const float fr = std::floor((s * points.x[i] + c * points.y[i] - oy) * inv);
-      if (!(fc >= 0.0f && fr >= 0.0f && fc < static_cast<float>(cols_) && fr < static_cast<float>(rows_))) continue;
+      if (!(fc >= 0.0f && fr >= 0.0f && fc < static_cast<float>(cols_) && fr < static_cast<float>(rows_)))
+        continue;
       const size_t k = static_cast<size_t>(fr) * static_cast<size_t>(cols_) + static_cast<size_t>(fc);
       sum[k] += points.grey[i];
       count[k] += 1.0f;
@@ -114,7 +118,6 @@ class Spectra {
 };
 
 struct SearchPeak {
-  int yaw_index = 0;
   double yaw = 0.0;
   Eigen::Vector2d shift;  // cells, sub-cell refined
   double correlation = 0.0;
@@ -149,12 +152,14 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
   const Eigen::Vector2d centre_b = box_b.center();
   double radius_b = 0.0;
   for (size_t i = 0; i < std::min(cloud_b.size(), grey_b.size()); ++i)
-    if (cloud_b[i].allFinite() && std::isfinite(grey_b[i])) radius_b = std::max(radius_b, (cloud_b[i].head<2>() - centre_b).norm());
+    if (cloud_b[i].allFinite() && std::isfinite(grey_b[i]))
+      radius_b = std::max(radius_b, (cloud_b[i].head<2>() - centre_b).norm());
   const int cols_a = static_cast<int>(std::ceil(box_a.sizes().x() / o.cell)) + 1;
   const int rows_a = static_cast<int>(std::ceil(box_a.sizes().y() / o.cell)) + 1;
   const int side_b = static_cast<int>(std::ceil(2.0 * radius_b / o.cell)) + 1;
   if (std::max({cols_a, rows_a, side_b}) > kMaxRasterCells)
-    return InvalidArgumentError("grey-level search: a raster of " + std::to_string(std::max({cols_a, rows_a, side_b})) +
+    return InvalidArgumentError("grey-level search: a raster of " +
+                                std::to_string(std::max({cols_a, rows_a, side_b})) +
                                 " cells per side, more than " + std::to_string(kMaxRasterCells));
   const int half_width = static_cast<int>(std::lround(o.local_mean_radius / o.cell));
   const Eigen::Vector2d origin_a = box_a.min();
@@ -163,7 +168,8 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
   ra.Fill(points_a, 0.0, origin_a);
 
   // Linear (not circular) correlation: every shift from -(side_b - 1) to size_a - 1.
-  const int rows = cv::getOptimalDFTSize(rows_a + side_b - 1), cols = cv::getOptimalDFTSize(cols_a + side_b - 1);
+  const int rows = cv::getOptimalDFTSize(rows_a + side_b - 1),
+            cols = cv::getOptimalDFTSize(cols_a + side_b - 1);
   cv::Mat fa, fa_sq, fa_mask;
   {
     Spectra spectra_a(rows, cols);
@@ -214,7 +220,6 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
       cv::minMaxLoc(score, nullptr, &best, nullptr, &at);
       if (best < o.min_correlation) break;
       SearchPeak p;
-      p.yaw_index = k;
       p.yaw = yaw;
       p.correlation = best;
       p.overlap = static_cast<int64_t>(std::lround(overlap.at<float>(at)));
@@ -224,7 +229,8 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
       };
       const auto vertex = [](double left, double mid, double right) {
         const double den = left - 2.0 * mid + right;
-        return left > -1.5 && right > -1.5 && den < 0.0 ? std::clamp(0.5 * (left - right) / den, -0.5, 0.5) : 0.0;
+        return left > -1.5 && right > -1.5 && den < 0.0 ? std::clamp(0.5 * (left - right) / den, -0.5, 0.5)
+                                                        : 0.0;
       };
       const double dc = vertex(value(at.y, at.x - 1), best, value(at.y, at.x + 1));
       const double dr = vertex(value(at.y - 1, at.x), best, value(at.y + 1, at.x));
@@ -234,11 +240,13 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
       p.t_xy = origin_a + o.cell * p.shift - origin_b;
       peaks.push_back(p);
       for (int r = at.y - suppress; r <= at.y + suppress; ++r)
-        for (int c = at.x - suppress; c <= at.x + suppress; ++c) score.at<float>((r + rows) % rows, (c + cols) % cols) = -2.0f;
+        for (int c = at.x - suppress; c <= at.x + suppress; ++c)
+          score.at<float>((r + rows) % rows, (c + cols) % cols) = -2.0f;
     }
   }
 
-  std::stable_sort(peaks.begin(), peaks.end(), [](const SearchPeak& x, const SearchPeak& y) { return x.correlation > y.correlation; });
+  std::stable_sort(peaks.begin(), peaks.end(),
+                   [](const SearchPeak& x, const SearchPeak& y) { return x.correlation > y.correlation; });
   std::vector<SearchPeak> kept;
   for (const SearchPeak& p : peaks) {
     if (static_cast<int64_t>(kept.size()) >= o.max_candidates) break;
@@ -256,7 +264,8 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
     const Eigen::Vector2d turned_centre = Eigen::Rotation2Dd(p.yaw) * centre_b;
     const Eigen::Vector2d origin_b = turned_centre - Eigen::Vector2d::Constant(radius_b);
     rb.Fill(points_b, p.yaw, origin_b);
-    const int sr = static_cast<int>(std::lround(p.shift.y())), sc = static_cast<int>(std::lround(p.shift.x()));
+    const int sr = static_cast<int>(std::lround(p.shift.y())),
+              sc = static_cast<int>(std::lround(p.shift.x()));
     dz.clear();
     for (int r = 0; r < side_b; ++r) {
       for (int c = 0; c < side_b; ++c) {

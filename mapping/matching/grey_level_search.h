@@ -22,16 +22,16 @@ namespace cairn {
 struct GreyLevelSearchOptions {
   // Off: the matcher's hypotheses come from the descriptors only (the thesis' pipeline).
   bool enabled = true;
-  double cell = 0.2;          // m; raster resolution
-  double yaw_step = 0.052;    // rad; 3 deg: at 5 m from the origin 0.13 m off, within the ICP's reach
-  double local_mean_radius = 0.4;  // m; half width of the window whose mean each cell loses
+  double cell = 0.2;                // m; raster resolution
+  double yaw_step = 0.052;          // rad; 3 deg: at 5 m from the origin 0.13 m off, within the ICP's reach
+  double local_mean_radius = 0.4;   // m; half width of the window whose mean each cell loses
   int64_t min_overlap_cells = 100;  // textured cells both rasters share (4 m^2 at 0.2 m)
   double min_correlation = 0.6;     // of the rasters under a candidate
   // The grey levels' correlation a refined candidate needs (the matcher's min_match_ncc, if
   // higher, applies too): a search picks the best of many alignments, so the grey levels that
   // chose it must vouch for it more than for a hypothesis the descriptors found.
   double min_match_ncc = 0.95;
-  int64_t max_candidates = 3;       // handed to the matcher, best first
+  int64_t max_candidates = 3;  // handed to the matcher, best first
   // Candidates closer to a better one than this are the same peak.
   double separation_translation = 0.5;  // m
   double separation_yaw = 0.2;          // rad
@@ -71,8 +71,10 @@ class GreyLevelSearch {
   // rasters beyond a sane size; no candidate is not an error.
   // `yaw_window` (centre, half width in rad) limits the yaws searched, e.g. to the gate around the
   // graph's relative estimate; half width >= pi searches all.
-  Expected<GreyLevelSearchResult> Search(const std::vector<Eigen::Vector3d>& cloud_a, const std::vector<float>& grey_a,
-                                         const std::vector<Eigen::Vector3d>& cloud_b, const std::vector<float>& grey_b,
+  Expected<GreyLevelSearchResult> Search(const std::vector<Eigen::Vector3d>& cloud_a,
+                                         const std::vector<float>& grey_a,
+                                         const std::vector<Eigen::Vector3d>& cloud_b,
+                                         const std::vector<float>& grey_b,
                                          Eigen::Vector2d yaw_window = {0.0, 4.0}) const;
 
  private:

@@ -12,9 +12,9 @@ namespace {
 
 // An aperiodic albedo pattern: random levels on a 0.3 m lattice, bilinearly interpolated, on
 // gently rolling ground.
-class Ground {
+class AlbedoGround {
  public:
-  explicit Ground(uint32_t seed) {
+  explicit AlbedoGround(uint32_t seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> level(40.0f, 200.0f);
     for (float& v : lattice_) v = level(rng);
@@ -23,9 +23,11 @@ class Ground {
     const double u = (x + 20.0) / 0.3, v = (y + 20.0) / 0.3;
     const int i = static_cast<int>(std::floor(u)), j = static_cast<int>(std::floor(v));
     const double fu = u - i, fv = v - j;
-    const auto at = [&](int a, int b) { return lattice_[static_cast<size_t>(((a % kN) + kN) % kN * kN + ((b % kN) + kN) % kN)]; };
-    return static_cast<float>((1 - fu) * (1 - fv) * at(i, j) + fu * (1 - fv) * at(i + 1, j) + (1 - fu) * fv * at(i, j + 1) +
-                              fu * fv * at(i + 1, j + 1));
+    const auto at = [&](int a, int b) {
+      return lattice_[static_cast<size_t>(((a % kN) + kN) % kN * kN + ((b % kN) + kN) % kN)];
+    };
+    return static_cast<float>((1 - fu) * (1 - fv) * at(i, j) + fu * (1 - fv) * at(i + 1, j) +
+                              (1 - fu) * fv * at(i, j + 1) + fu * fv * at(i + 1, j + 1));
   }
   static double Height(double x, double y) { return 0.1 * std::sin(0.5 * x) + 0.05 * std::cos(0.7 * y); }
 
@@ -49,7 +51,7 @@ class Ground {
 };
 
 TEST(GreyLevelSearchTest, FindsTheTurnAndShiftOfAnOverlappingPatch) {
-  const Ground ground(7);
+  const AlbedoGround ground(7);
   const FourDofTransform T_world_a(1.0, -2.0, 0.3, 0.4);
   const FourDofTransform T_world_b(3.5, 0.5, -0.2, 2.1);
   std::vector<Eigen::Vector3d> a, b;
@@ -72,7 +74,7 @@ TEST(GreyLevelSearchTest, FindsTheTurnAndShiftOfAnOverlappingPatch) {
 // Chance alignments of unrelated ground over a few square metres can pass the raster threshold;
 // they stay well below a true one (above 0.8), and the matcher's checks at 5 cm refuse them.
 TEST(GreyLevelSearchTest, PatchesOfDifferentGroundCorrelateWeakly) {
-  const Ground one(7), other(8);
+  const AlbedoGround one(7), other(8);
   std::vector<Eigen::Vector3d> a, b;
   std::vector<float> ga, gb;
   one.Sample({0.0, 0.0}, 5.0, FourDofTransform(), &a, &ga);
@@ -83,7 +85,7 @@ TEST(GreyLevelSearchTest, PatchesOfDifferentGroundCorrelateWeakly) {
 }
 
 TEST(GreyLevelSearchTest, AYawWindowSearchesOnlyItsYaws) {
-  const Ground ground(7);
+  const AlbedoGround ground(7);
   std::vector<Eigen::Vector3d> a, b;
   std::vector<float> ga, gb;
   ground.Sample({0.0, 0.0}, 4.0, FourDofTransform(), &a, &ga);

@@ -57,9 +57,10 @@ PhotometricScore PhotometricAgreement::Score(const std::vector<Eigen::Vector3d>&
   return out;
 }
 
-FourDofTransform PhotometricAgreement::Refine(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
-                                              const FourDofTransform& start, double step_translation,
-                                              double step_yaw, int max_scores, PhotometricScore* best) const {
+FourDofTransform PhotometricAgreement::Refine(const std::vector<Eigen::Vector3d>& cloud,
+                                              const std::vector<float>& grey, const FourDofTransform& start,
+                                              double step_translation, double step_yaw, int max_scores,
+                                              PhotometricScore* best) const {
   const auto Value = [](const PhotometricScore& s) { return std::isfinite(s.ncc) ? s.ncc : -2.0; };
   FourDofTransform at = start;
   PhotometricScore here = Score(cloud, grey, at);

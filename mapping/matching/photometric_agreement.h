@@ -41,8 +41,8 @@ class PhotometricAgreement {
   // where the ground is smooth, the ICP leaves yaw and the slide along a rim to chance, which the
   // albedo pattern pins down. At most `max_scores` scores; `best` gets the final one.
   FourDofTransform Refine(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
-                          const FourDofTransform& start, double step_translation, double step_yaw, int max_scores,
-                          PhotometricScore* best) const;
+                          const FourDofTransform& start, double step_translation, double step_yaw,
+                          int max_scores, PhotometricScore* best) const;
 
  private:
   float inverse_voxel_ = 20.0f;

@@ -341,7 +341,8 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
                                                           static_cast<long long>(options_.min_icp_inliers)));
     } else if (prior.has_value() && !WithinGate(fit.T_a_b, *prior, &why)) {
       rejections.Add("refinements outside the gate", "refined match " + why);
-    } else if (const Verdict grey = six ? Judge(min_match_ncc, fit.T_full, &why) : Judge(min_match_ncc, fit.T_a_b, &why);
+    } else if (const Verdict grey =
+                   six ? Judge(min_match_ncc, fit.T_full, &why) : Judge(min_match_ncc, fit.T_a_b, &why);
                grey == Verdict::kDisagree) {
       ++r.photometric_rejected;
       r.photometric = last_grey;
@@ -386,13 +387,15 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       const double sigma = std::sqrt(std::max(prior->covariance(3, 3), 0.0));
       yaw_window = {prior->T_a_b.yaw(), std::max(options_.gate_sigmas * sigma, options_.gate_floor_yaw)};
     }
-    Expected<GreyLevelSearchResult> found = GreyLevelSearch(options_.grey_search)
-                                                .Search(a.cloud, a.cloud_grey, b.cloud, b.cloud_grey, yaw_window);
+    Expected<GreyLevelSearchResult> found =
+        GreyLevelSearch(options_.grey_search)
+            .Search(a.cloud, a.cloud_grey, b.cloud, b.cloud_grey, yaw_window);
     r.times.search_ms = MillisecondsSince(stage);
     if (!found.ok()) {
       rejections.Add("grey-level search refused", found.status().message());
     } else {
-      if (found->candidates.empty()) rejections.Add("grey-level search without a candidate", "grey-level search: no candidate");
+      if (found->candidates.empty())
+        rejections.Add("grey-level search without a candidate", "grey-level search: no candidate");
       for (const GreyLevelCandidate& candidate : found->candidates) {
         ++r.searched;
         Hypothesis h;
@@ -411,8 +414,9 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
         h.grey_agreed = true;
         const auto icp_start = Clock::now();
         const bool matched =
-            Refined(h, Format("grey-level search, raster correlation %.3f over %lld cells", candidate.correlation,
-                              static_cast<long long>(candidate.overlap_cells)),
+            Refined(h,
+                    Format("grey-level search, raster correlation %.3f over %lld cells",
+                           candidate.correlation, static_cast<long long>(candidate.overlap_cells)),
                     std::max(options_.min_match_ncc, options_.grey_search.min_match_ncc));
         r.times.icp_ms += MillisecondsSince(icp_start);
         if (matched) return finish(MatchStatus::kMatched, r.reason);

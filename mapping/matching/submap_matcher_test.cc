@@ -128,8 +128,8 @@ TEST_F(SubmapMatcherTest, AGoodRelativeEstimateKeepsTheMatch) {
 }
 
 // Descriptors that yield no hypothesis (here no cluster can reach the consensus asked for) leave
-// the pair unmatched without the grey-level search; with it (the default), the ground's pattern seen from above still
-// finds the match, and the search's candidates meet the same gate.
+// the pair unmatched without the grey-level search; with it (the default), the ground's pattern seen from
+// above still finds the match, and the search's candidates meet the same gate.
 TEST_F(SubmapMatcherTest, TheGreyLevelSearchFindsWhatTheDescriptorsMiss) {
   const SubmapFeatures& b = *features_b_;
   SubmapMatcherOptions options;
@@ -155,7 +155,8 @@ TEST_F(SubmapMatcherTest, TheGreyLevelSearchFindsWhatTheDescriptorsMiss) {
   wrong.covariance = Eigen::Vector4d(0.04, 0.04, 0.01, 0.01).asDiagonal();
   const SubmapMatchResult gated = SubmapMatcher(options).Match(*features_a_, b, wrong);
   EXPECT_EQ(gated.status, MatchStatus::kNoMatch);
-  EXPECT_NE(gated.reason.find("searched candidate x off the relative estimate"), std::string::npos) << gated.reason;
+  EXPECT_NE(gated.reason.find("searched candidate x off the relative estimate"), std::string::npos)
+      << gated.reason;
 }
 
 TEST_F(SubmapMatcherTest, AConfidentWrongEstimateGatesTheMatchOut) {
