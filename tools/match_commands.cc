@@ -259,10 +259,8 @@ int RunBenchMatch(const CommandArgs& args) {
         std::printf(" error %.3f m %.2f deg, grey levels %.3f", error.translation().norm(),
                     std::abs(error.yaw()) * 180 / M_PI, r.photometric.ncc);
         if (r.dof == 6) std::printf(", tilt %.2f deg", r.tilt * 180 / M_PI);
-        std::printf(" (%s)", r.reason.c_str());
-      } else {
-        std::printf(" (%s)", r.reason.c_str());
       }
+      std::printf(" (%s)", r.reason.c_str());
       std::printf(", %.0f ms\n", r.times.total_ms);
     }
   }

@@ -140,20 +140,18 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
 
   // A's raster over its points' xy box; B's turned about its box centre within a square that
   // holds it at every yaw.
+  const GreyPoints points_a(cloud_a, grey_a), points_b(cloud_b, grey_b);
   Eigen::AlignedBox2d box_a, box_b;
-  for (size_t i = 0; i < std::min(cloud_a.size(), grey_a.size()); ++i)
-    if (cloud_a[i].allFinite() && std::isfinite(grey_a[i])) box_a.extend(cloud_a[i].head<2>());
-  for (size_t i = 0; i < std::min(cloud_b.size(), grey_b.size()); ++i)
-    if (cloud_b[i].allFinite() && std::isfinite(grey_b[i])) box_b.extend(cloud_b[i].head<2>());
+  for (size_t i = 0; i < points_a.size(); ++i) box_a.extend(Eigen::Vector2d(points_a.x[i], points_a.y[i]));
+  for (size_t i = 0; i < points_b.size(); ++i) box_b.extend(Eigen::Vector2d(points_b.x[i], points_b.y[i]));
   if (box_a.isEmpty() || box_b.isEmpty()) {
     out.ms = MillisecondsSince(start);
     return out;
   }
   const Eigen::Vector2d centre_b = box_b.center();
   double radius_b = 0.0;
-  for (size_t i = 0; i < std::min(cloud_b.size(), grey_b.size()); ++i)
-    if (cloud_b[i].allFinite() && std::isfinite(grey_b[i]))
-      radius_b = std::max(radius_b, (cloud_b[i].head<2>() - centre_b).norm());
+  for (size_t i = 0; i < points_b.size(); ++i)
+    radius_b = std::max(radius_b, (Eigen::Vector2d(points_b.x[i], points_b.y[i]) - centre_b).norm());
   const int cols_a = static_cast<int>(std::ceil(box_a.sizes().x() / o.cell)) + 1;
   const int rows_a = static_cast<int>(std::ceil(box_a.sizes().y() / o.cell)) + 1;
   const int side_b = static_cast<int>(std::ceil(2.0 * radius_b / o.cell)) + 1;
@@ -163,7 +161,6 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
                                 " cells per side, more than " + std::to_string(kMaxRasterCells));
   const int half_width = static_cast<int>(std::lround(o.local_mean_radius / o.cell));
   const Eigen::Vector2d origin_a = box_a.min();
-  const GreyPoints points_a(cloud_a, grey_a), points_b(cloud_b, grey_b);
   Raster ra(rows_a, cols_a, o.cell, half_width);
   ra.Fill(points_a, 0.0, origin_a);
 

@@ -39,7 +39,7 @@ class PhotometricAgreement {
   // x, y and yaw of `start` moved to where B's grey levels correlate best with A's, by a pattern
   // search from steps of `step_translation` and `step_yaw` halved down to a tenth (z is kept):
   // where the ground is smooth, the ICP leaves yaw and the slide along a rim to chance, which the
-  // albedo pattern pins down. At most `max_scores` scores; `best` gets the final one.
+  // albedo pattern pins down. At most `max_scores` scores; `best`, if given, gets the final one.
   FourDofTransform Refine(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
                           const FourDofTransform& start, double step_translation, double step_yaw,
                           int max_scores, PhotometricScore* best) const;

@@ -95,14 +95,19 @@ struct Refinement {
   int64_t iterations = 0;
   double shift = 0.0;  // m
   double turn = 0.0;   // rad
+
+  // shift and turn: how far T_a_b lies from where the refinement started (4-DoF).
+  void MovedFrom(const FourDofTransform& start) {
+    const FourDofTransform moved = start.inverse() * T_a_b;
+    shift = moved.translation().norm();
+    turn = std::abs(moved.yaw());
+  }
 };
 
 Refinement Refine4(const FourDofIcp& icp, const SubmapFeatures& a, const SubmapFeatures& b, const Hypothesis& h) {
   const FourDofIcpResult fit = icp.Align(a.cloud, b.cloud, h.T_a_b);
   Refinement out{fit.status, fit.T_a_b, fit.T_a_b.ToIsometry(), fit.covariance, fit.inliers, fit.rms, fit.iterations};
-  const FourDofTransform moved = h.T_a_b.inverse() * fit.T_a_b;
-  out.shift = moved.translation().norm();
-  out.turn = std::abs(moved.yaw());
+  out.MovedFrom(h.T_a_b);
   return out;
 }
 
@@ -318,16 +323,13 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     }
     if (!six && options_.grey_refinement && min_match_ncc > -1.0) {
       if (!photometric) photometric.emplace(a.cloud, a.cloud_grey, options_.photometric_voxel);
-      PhotometricScore refined_score;
       fit.T_a_b = photometric->Refine(b.cloud, b.cloud_grey, fit.T_a_b, options_.grey_refinement_step,
                                       options_.grey_refinement_step_yaw,
-                                      static_cast<int>(options_.grey_refinement_max_scores), &refined_score);
+                                      static_cast<int>(options_.grey_refinement_max_scores), nullptr);
       // Not the ICP again from there: on the team missions it slid back (seed 3: 10 matches
       // within 5 cm and 0.5 deg instead of 13).
       fit.T_full = fit.T_a_b.ToIsometry();
-      const FourDofTransform moved = h.T_a_b.inverse() * fit.T_a_b;
-      fit.shift = moved.translation().norm();
-      fit.turn = std::abs(moved.yaw());
+      fit.MovedFrom(h.T_a_b);
     }
     std::string why;
     if (fit.shift > options_.max_refinement_translation || fit.turn > options_.max_refinement_yaw) {
