@@ -43,6 +43,7 @@ LocalMapper::LocalMapper(const MappingOptions& options, const StereoCamera& came
       fusion_(options.fusion, camera, projector_.error_model()),
       classifier_(options.obstacles, camera, projector_.error_model(), projector_.range()),
       integrator_(options.submap.octree_resolution, MaxDistance(camera, projector_.range())),
+      planes_(options.planes, projector_.error_model()),
       rolling_(options.rolling_map),
       partitioner_(options.partition, requester),
       open_(std::make_unique<OpenSubmap>(options.submap, robot_, 0)) {}
@@ -50,7 +51,7 @@ LocalMapper::LocalMapper(const MappingOptions& options, const StereoCamera& came
 std::shared_ptr<const Submap> LocalMapper::FinishAndStart(uint64_t new_frame_id) {
   std::shared_ptr<const Submap> done;
   if (open_->metadata().images > 0) {
-    done = open_->Finish();
+    done = open_->Finish(options_.planes.enabled ? &planes_ : nullptr);
     ++stats_.submaps_finished;
   }
   open_->Restart(new_frame_id);

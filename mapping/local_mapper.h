@@ -68,6 +68,7 @@ class LocalMapper {
   DepthFusion fusion_;
   ObstacleClassifier classifier_;
   OccupancyIntegrator integrator_;
+  PlaneExtractor planes_;
   RollingObstacleMap rolling_;
   SubmapPartitioner partitioner_;
   std::unique_ptr<OpenSubmap> open_;

@@ -136,6 +136,32 @@ struct SubmapOptions {
   }
 };
 
+// Planar faces of a finished submap (paper 003's region growing from the flattest cell, after
+// Weingarten): cells of the cloud that are thin are grown into planes while their normals and
+// offsets agree with the plane fitted so far. Tolerances scale with the stereo error (eq. 5.2) of
+// each cell as its nearest viewpoint saw it, with a floor for near range.
+struct PlaneOptions {
+  bool enabled = true;
+  double cell_size = 0.3;          // m, side of the cubes planes are grown from
+  int64_t min_cell_points = 12;    // cloud points a cube needs to be tested for flatness
+  double tolerance_sigmas = 3.0;   // a cube's thickness and offset from the plane, in its error
+  double min_tolerance = 0.02;     // m, floor of those tolerances
+  double max_normal_angle = 10.0;  // deg between a cube's normal and the plane's
+  double min_area = 1.0;           // m^2 of cubes a plane must cover
+  int64_t max_planes = 32;         // largest kept per submap
+
+  void Visit(OptionsVisitor& v) {
+    v.Flag("enabled", enabled);
+    v.Number("cell_size", cell_size, 0.05, 5.0, "m");
+    v.Integer("min_cell_points", min_cell_points, 4, 100000, "points");
+    v.Number("tolerance_sigmas", tolerance_sigmas, 0.5, 20.0, "sigma");
+    v.Number("min_tolerance", min_tolerance, 0.0, 1.0, "m");
+    v.Number("max_normal_angle", max_normal_angle, 0.5, 60.0, "deg");
+    v.Number("min_area", min_area, 0.01, 10000.0, "m^2");
+    v.Integer("max_planes", max_planes, 1, 1000, "planes");
+  }
+};
+
 // When a new submap starts (thesis 5.1.3).
 struct PartitionOptions {
   double max_position_sigma = 0.1;  // m, largest standard deviation of the position
@@ -169,6 +195,7 @@ struct MappingOptions {
   ObstacleOptions obstacles;
   RollingMapOptions rolling_map;
   SubmapOptions submap;
+  PlaneOptions planes;
   PartitionOptions partition;
   CompositionOptions composition;
 
@@ -178,6 +205,7 @@ struct MappingOptions {
     v.Section("obstacles", obstacles);
     v.Section("rolling_map", rolling_map);
     v.Section("submap", submap);
+    v.Section("planes", planes);
     v.Section("partition", partition);
     v.Section("composition", composition);
   }

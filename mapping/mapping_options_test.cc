@@ -18,6 +18,8 @@ rolling_map: {cell_size: 0.05, cells: 400, low_pass: 0.3}
 submap: {cloud_resolution: 0.05, octree_resolution: 0.1, log_odds_hit: 0.85, log_odds_miss: -0.4,
          log_odds_min: -2.0, log_odds_max: 3.5, wire_offset_bits: 3,
          wire_intensity_bits: 7}
+planes: {enabled: true, cell_size: 0.25, min_cell_points: 12, tolerance_sigmas: 3.0, min_tolerance: 0.02,
+         max_normal_angle: 10.0, min_area: 1.0, max_planes: 32}
 partition: {max_position_sigma: 0.2, max_distance: 7.0, retry_interval: 1.0}
 composition: {cloud_resolution: 0.05, rebuild_translation: 0.02, rebuild_rotation_deg: 0.2}
 )";
@@ -27,6 +29,7 @@ TEST(MappingOptionsTest, LoadsFromYamlAndNamesBadKeys) {
   YamlOptionsReader reader(YAML::Load(kYaml), "mapping.yaml");
   ASSERT_TRUE(reader.Read(o).ok()) << reader.Read(o).ToString();
   EXPECT_DOUBLE_EQ(o.partition.max_position_sigma, 0.2);
+  EXPECT_DOUBLE_EQ(o.planes.cell_size, 0.25);
   EXPECT_EQ(o.obstacles.window_cells, 4);
   EXPECT_DOUBLE_EQ(o.obstacles.max_step, 0.1);
   EXPECT_DOUBLE_EQ(o.obstacles.step_tie_tolerance, 0.01);

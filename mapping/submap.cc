@@ -25,11 +25,13 @@ size_t TreeHeapBytes(const octomap::OcTree& tree) {
 
 }  // namespace
 
-Submap::Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree)
+Submap::Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree,
+               SubmapStructure structure)
     : metadata_(std::move(metadata)),
       points_(std::move(points)),
       tree_(WithoutRayBuffers(std::move(tree))),
-      tree_bytes_(TreeHeapBytes(*tree_)) {}
+      tree_bytes_(TreeHeapBytes(*tree_)),
+      structure_(std::move(structure)) {}
 
 int64_t Submap::obstacle_points() const {
   int64_t n = 0;
@@ -38,7 +40,8 @@ int64_t Submap::obstacle_points() const {
 }
 
 size_t Submap::memory_bytes() const {
-  return sizeof(*this) + HeapBytes(points_) + tree_bytes_;
+  return sizeof(*this) + HeapBytes(points_) + tree_bytes_ + HeapBytes(structure_.viewpoints) +
+         HeapBytes(structure_.planes);
 }
 
 OpenSubmap::OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id)
@@ -52,6 +55,11 @@ OccupancyUpdateStats OpenSubmap::Integrate(const CameraPoints& pts, OccupancyInt
   if (metadata_.images == 0) metadata_.start = pts.time;
   metadata_.end = pts.time;
   ++metadata_.images;
+  const Eigen::Vector3f view = pts.T_local_cam.translation().cast<float>();
+  if (view.allFinite() && (viewpoints_.empty() || (view - viewpoints_.back()).squaredNorm() >=
+                                                      kViewpointSpacing * kViewpointSpacing)) {
+    viewpoints_.push_back(view);
+  }
   cells_.interior.clear();
   cells_.on_face.clear();
   cloud_.AddBatch(pts.p_local, pts.intensity, pts.obstacle, &cells_);
@@ -63,6 +71,7 @@ void OpenSubmap::Restart(uint64_t id) {
     cloud_.Clear();
     tree_ = MakeOccupancyTree(metadata_.options);
   }
+  viewpoints_.clear();
   SubmapMetadata fresh;
   fresh.robot = std::move(metadata_.robot);
   fresh.id = id;
@@ -70,10 +79,16 @@ void OpenSubmap::Restart(uint64_t id) {
   metadata_ = std::move(fresh);
 }
 
-std::shared_ptr<const Submap> OpenSubmap::Finish() {
+std::shared_ptr<const Submap> OpenSubmap::Finish(PlaneExtractor* planes) {
   tree_->updateInnerOccupancy();
   tree_->prune();
-  auto submap = std::make_shared<const Submap>(metadata_, cloud_.Points(), std::move(tree_));
+  SubmapStructure structure;
+  std::vector<CloudPoint> points = cloud_.Points();
+  if (planes != nullptr) structure.planes = planes->Extract(points, viewpoints_);
+  structure.viewpoints = std::move(viewpoints_);
+  viewpoints_.clear();
+  auto submap =
+      std::make_shared<const Submap>(metadata_, std::move(points), std::move(tree_), std::move(structure));
   tree_ = MakeOccupancyTree(metadata_.options);
   cloud_.Clear();
   return submap;

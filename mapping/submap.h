@@ -14,6 +14,8 @@
 #include "common/timestamp.h"
 #include "mapping/mapping_options.h"
 #include "mapping/occupancy_integrator.h"
+#include "mapping/plane_extractor.h"
+#include "mapping/submap_plane.h"
 #include "mapping/voxel_cloud.h"
 
 namespace cairn {
@@ -27,13 +29,22 @@ struct SubmapMetadata {
   SubmapOptions options;      // resolutions and log-odds the maps were made with
 };
 
+// What a submap holds beyond its cloud and tree: where its cameras were (one viewpoint per
+// OpenSubmap::kViewpointSpacing of travel, the submap frame) and its planar faces.
+struct SubmapStructure {
+  std::vector<Eigen::Vector3f> viewpoints;
+  std::vector<SubmapPlane> planes;
+};
+
 class Submap {
  public:
-  Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree);
+  Submap(SubmapMetadata metadata, std::vector<CloudPoint> points, std::unique_ptr<octomap::OcTree> tree,
+         SubmapStructure structure = {});
 
   const SubmapMetadata& metadata() const { return metadata_; }
   const std::vector<CloudPoint>& points() const { return points_; }
   const octomap::OcTree& tree() const { return *tree_; }
+  const SubmapStructure& structure() const { return structure_; }
   int64_t obstacle_points() const;
   // Heap held: the cloud and the octree's heap blocks.
   size_t memory_bytes() const;
@@ -43,6 +54,7 @@ class Submap {
   std::vector<CloudPoint> points_;
   std::unique_ptr<const octomap::OcTree> tree_;
   size_t tree_bytes_ = 0;
+  SubmapStructure structure_;
 };
 
 class OpenSubmap {
@@ -53,8 +65,13 @@ class OpenSubmap {
   OccupancyUpdateStats Integrate(const CameraPoints& points, OccupancyIntegrator* integrator);
   void AddDistance(double d) { metadata_.distance += d; }
 
-  // Inner nodes updated and the tree pruned; the open submap is left empty.
-  std::shared_ptr<const Submap> Finish();
+  // Viewpoints closer than this to the last one kept are not kept: the stereo error of a point
+  // seen from either differs by a few per cent at the ranges submaps keep.
+  static constexpr float kViewpointSpacing = 0.25f;
+
+  // Inner nodes updated and the tree pruned; the open submap is left empty. With `planes`, the
+  // planar faces are extracted.
+  std::shared_ptr<const Submap> Finish(PlaneExtractor* planes = nullptr);
   // Starts over, empty, as submap `id`. The voxel table keeps its capacity: a new one per submap
   // (megabytes, freed while the finished submap's small blocks filled the heap around it) left
   // the heap fragmented, growing by about 5 MB per submap.
@@ -68,6 +85,7 @@ class OpenSubmap {
   SubmapMetadata metadata_;
   VoxelCloud cloud_;
   VoxelCloud::Cells cells_;  // of the last image, for the integrator
+  std::vector<Eigen::Vector3f> viewpoints_;
   std::unique_ptr<octomap::OcTree> tree_;
 };
 

@@ -25,6 +25,72 @@ constexpr int kZstdLevel = 3;
 
 void F64(ByteWriter& w, double v) { w.U64(std::bit_cast<uint64_t>(v)); }
 double F64(ByteReader& r) { return std::bit_cast<double>(r.U64()); }
+void F32(ByteWriter& w, float v) { w.U32(std::bit_cast<uint32_t>(v)); }
+float F32(ByteReader& r) { return std::bit_cast<float>(r.U32()); }
+
+// Caps of the structure stream, far above what a submap holds, against counts that lie.
+constexpr uint32_t kMaxViewpoints = 1u << 20;
+constexpr uint32_t kMaxPlanes = 1u << 16;
+
+void WriteStructure(const SubmapStructure& s, ByteWriter& w) {
+  w.U32(static_cast<uint32_t>(s.viewpoints.size()));
+  for (const Eigen::Vector3f& v : s.viewpoints) {
+    for (int a = 0; a < 3; ++a) F32(w, v[a]);
+  }
+  w.U32(static_cast<uint32_t>(s.planes.size()));
+  for (const SubmapPlane& p : s.planes) {
+    for (int a = 0; a < 3; ++a) F32(w, p.normal[a]);
+    F32(w, p.offset);
+    for (int a = 0; a < 3; ++a) F32(w, p.centroid[a]);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = i; j < 3; ++j) F32(w, p.covariance(i, j));
+    }
+    for (int a = 0; a < 2; ++a) F32(w, p.min[a]);
+    for (int a = 0; a < 2; ++a) F32(w, p.max[a]);
+    F32(w, p.area);
+    w.U32(p.points);
+  }
+}
+
+Status ReadStructure(ByteReader& r, SubmapStructure* s) {
+  const uint32_t views = r.U32();
+  if (r.failed() || views > kMaxViewpoints || uint64_t{views} * 12 > r.remaining())
+    return DataLossError("submap viewpoint count " + std::to_string(views) + " exceeds the data");
+  s->viewpoints.resize(views);
+  for (uint32_t i = 0; i < views; ++i) {
+    for (int a = 0; a < 3; ++a) s->viewpoints[i][a] = F32(r);
+    if (!s->viewpoints[i].allFinite())
+      return DataLossError("submap viewpoint " + std::to_string(i) + " is not finite");
+  }
+  const uint32_t planes = r.U32();
+  constexpr uint64_t kPlaneBytes = 19 * 4;  // 18 floats and the point count
+  if (r.failed() || planes > kMaxPlanes || uint64_t{planes} * kPlaneBytes != r.remaining())
+    return DataLossError("submap plane count " + std::to_string(planes) + " does not match the data");
+  s->planes.resize(planes);
+  for (uint32_t k = 0; k < planes; ++k) {
+    SubmapPlane& p = s->planes[k];
+    for (int a = 0; a < 3; ++a) p.normal[a] = F32(r);
+    p.offset = F32(r);
+    for (int a = 0; a < 3; ++a) p.centroid[a] = F32(r);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = i; j < 3; ++j) p.covariance(i, j) = p.covariance(j, i) = F32(r);
+    }
+    for (int a = 0; a < 2; ++a) p.min[a] = F32(r);
+    for (int a = 0; a < 2; ++a) p.max[a] = F32(r);
+    p.area = F32(r);
+    p.points = r.U32();
+    const std::string at = "submap plane " + std::to_string(k) + ": ";
+    if (!p.normal.allFinite() || std::abs(p.normal.norm() - 1.0f) > 1e-3f)
+      return DataLossError(at + "normal is not a unit vector");
+    if (!std::isfinite(p.offset) || !p.centroid.allFinite())
+      return DataLossError(at + "offset or centroid is not finite");
+    if (!p.covariance.allFinite() || (p.covariance.diagonal().array() < 0.0f).any())
+      return DataLossError(at + "covariance is not finite or has a negative variance");
+    if (!(p.min.array() <= p.max.array()).all() || !(p.area >= 0.0f && std::isfinite(p.area)))
+      return DataLossError(at + "extent or area is invalid");
+  }
+  return Status::Ok();
+}
 
 void Varint(std::vector<uint8_t>& out, uint64_t v) {
   while (v >= 0x80) {
@@ -146,7 +212,10 @@ Status SubmapCodec::ValidateOctreeBinary(std::span<const uint8_t> data) {
   return Status::Ok();
 }
 
-Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compression compression) {
+Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compression compression,
+                                                   uint16_t version) {
+  if (version < kOldestVersion || version > kVersion)
+    return InvalidArgumentError("submap format version " + std::to_string(version) + " cannot be written");
   const SubmapMetadata& m = submap.metadata();
   if (m.robot.size() > 255) return InvalidArgumentError("submap robot name longer than 255 bytes");
   if (const std::string problem = WireBitsProblem(m.options); !problem.empty()) {
@@ -267,6 +336,10 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   const std::string tree = TreeBinary(submap.tree());
   w.U64(tree.size());
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(tree.data()), tree.size()));
+  if (version >= 4) {
+    cuts.push_back(w.size());
+    WriteStructure(submap.structure(), w);
+  }
 
   cuts.push_back(w.size());
   if (w.size() > kMaxPayload)
@@ -285,7 +358,7 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   const std::vector<uint8_t>& compressed = body.buffer();
   ByteWriter out;
   out.Bytes(std::span(reinterpret_cast<const uint8_t*>(kMagic), sizeof(kMagic)));
-  out.U16(kVersion);
+  out.U16(version);
   out.U8(static_cast<uint8_t>(compression));
   out.U8(0);
   out.U64(w.size());
@@ -310,10 +383,9 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   const uint32_t raw_crc = h.U32();
   const uint32_t packed_crc = h.U32();
   if (h.failed()) return DataLossError("submap header truncated");
-  if (version != kVersion) {
-    // Earlier versions are not read any more: robots of a team run one version.
-    return DataLossError("submap format version " + std::to_string(version) + " is not supported (expected " +
-                         std::to_string(kVersion) + ")");
+  if (version < kOldestVersion || version > kVersion) {
+    return DataLossError("submap format version " + std::to_string(version) + " is not supported (" +
+                         std::to_string(kOldestVersion) + " to " + std::to_string(kVersion) + ")");
   }
   if (reserved != 0) return DataLossError("submap header reserved byte is " + std::to_string(reserved));
   if (compression > static_cast<uint8_t>(Compression::kLz4)) return DataLossError("submap has unknown compression " + std::to_string(compression));
@@ -450,8 +522,11 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
   }
   if (keys.remaining() != 0) return DataLossError("submap voxel index stream has trailing bytes");
   const uint64_t tree_size = r.U64();
-  if (r.failed() || tree_size != r.remaining()) return DataLossError("submap octree size does not match the data");
+  if (r.failed() || (version >= 4 ? tree_size > r.remaining() : tree_size != r.remaining()))
+    return DataLossError("submap octree size does not match the data");
   const auto tree_bytes = r.Take(tree_size);
+  SubmapStructure structure;
+  if (version >= 4) CAIRN_RETURN_IF_ERROR(ReadStructure(r, &structure));
   CAIRN_RETURN_IF_ERROR(ValidateOctreeBinary(tree_bytes).WithContext("submap octree"));
   auto tree = MakeOccupancyTree(m.options);
   if (!tree_bytes.empty()) {
@@ -459,7 +534,7 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
     tree->readBinaryData(s);
     if (!s) return DataLossError("submap octree does not parse");
   }
-  return std::make_shared<const Submap>(std::move(m), std::move(pts), std::move(tree));
+  return std::make_shared<const Submap>(std::move(m), std::move(pts), std::move(tree), std::move(structure));
 }
 
 Expected<std::shared_ptr<const Submap>> SubmapCodec::ReadFile(const std::string& path) {

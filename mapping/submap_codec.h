@@ -5,8 +5,10 @@
 // at `wire_intensity_bits`, as the difference to the mean of its causal face neighbours), obstacle
 // bits, and the occupancy tree in OctoMap's binary format (maximum-likelihood free/occupied leaves,
 // pruned); each stream compressed on its own (zstd or LZ4), all protected by CRC-32s of the
-// compressed and the uncompressed bytes. Only the current version decodes (version 2 had 4 offset
-// bits, 8 intensity bits and one compressed block; version 1 raw channels).
+// compressed and the uncompressed bytes. Version 4 adds a last stream: the viewpoints and the
+// planar faces (float32, exact). Versions 4 and 3 (no such stream) decode, and either is encoded on
+// request, for teammates still on version 3; version 2 (4 offset bits, 8 intensity bits, one
+// compressed block) and version 1 (raw channels) are not read any more.
 //
 // Lossy by design: points move by at most resolution / 2^(bits+1) per axis, intensity and colour
 // by half a step (exact at 8 bits); both bit counts travel in the submap's options, so decoding and
@@ -28,10 +30,12 @@ namespace cairn {
 
 class SubmapCodec {
  public:
-  static constexpr uint16_t kVersion = 3;
+  static constexpr uint16_t kVersion = 4;
+  static constexpr uint16_t kOldestVersion = 3;
 
   static Expected<std::vector<uint8_t>> Encode(const Submap& submap,
-                                               Compression compression = Compression::kZstd);
+                                               Compression compression = Compression::kZstd,
+                                               uint16_t version = kVersion);
   // Validates everything (magic, version, sizes, checksums, every field and the tree structure)
   // and names the first problem.
   static Expected<std::shared_ptr<const Submap>> Decode(std::span<const uint8_t> bytes);

@@ -221,6 +221,90 @@ TEST(SubmapCodecTest, RejectsCorruptInputWithAClearError) {
   EXPECT_NE(SubmapCodec::Decode(bad).status().message().find("checksum"), std::string::npos);
 }
 
+std::shared_ptr<const Submap> WithStructure(const Submap& s, SubmapStructure structure) {
+  return std::make_shared<const Submap>(s.metadata(), s.points(), std::make_unique<octomap::OcTree>(s.tree()),
+                                        std::move(structure));
+}
+
+SubmapStructure SomeStructure() {
+  SubmapStructure st;
+  st.viewpoints = {{0.0f, 0.0f, 0.5f}, {0.3f, -0.1f, 0.52f}, {0.61f, -0.2f, 0.49f}};
+  SubmapPlane floor;
+  floor.offset = 0.01f;
+  floor.centroid = {1.0f, 0.2f, -0.01f};
+  floor.covariance << 1e-6f, 1e-8f, 2e-7f, 1e-8f, 2e-6f, -3e-7f, 2e-7f, -3e-7f, 4e-6f;
+  floor.min = {-2.0f, -1.5f};
+  floor.max = {2.5f, 1.25f};
+  floor.area = 9.5f;
+  floor.points = 3800;
+  SubmapPlane wall = floor;
+  wall.normal = Eigen::Vector3f(-0.8f, 0.6f, 0.0f);
+  wall.offset = 3.25f;
+  wall.points = 900;
+  st.planes = {floor, wall};
+  return st;
+}
+
+TEST(SubmapCodecTest, ViewpointsAndPlanesRoundTripExactly) {
+  const auto submap = WithStructure(*testing::SyntheticSubmap(3), SomeStructure());
+  auto bytes = SubmapCodec::Encode(*submap);
+  ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
+  auto back = SubmapCodec::Decode(*bytes);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  const SubmapStructure& a = submap->structure();
+  const SubmapStructure& b = (*back)->structure();
+  ASSERT_EQ(b.viewpoints.size(), a.viewpoints.size());
+  for (size_t i = 0; i < a.viewpoints.size(); ++i) EXPECT_EQ(b.viewpoints[i], a.viewpoints[i]);
+  ASSERT_EQ(b.planes.size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(b.planes[k].normal, a.planes[k].normal);
+    EXPECT_EQ(b.planes[k].offset, a.planes[k].offset);
+    EXPECT_EQ(b.planes[k].centroid, a.planes[k].centroid);
+    EXPECT_EQ(b.planes[k].covariance, a.planes[k].covariance);
+    EXPECT_EQ(b.planes[k].min, a.planes[k].min);
+    EXPECT_EQ(b.planes[k].max, a.planes[k].max);
+    EXPECT_EQ(b.planes[k].area, a.planes[k].area);
+    EXPECT_EQ(b.planes[k].points, a.planes[k].points);
+  }
+  EXPECT_EQ((*back)->points().size(), submap->points().size());
+}
+
+TEST(SubmapCodecTest, VersionThreeIsStillWrittenAndReadWithoutTheStructure) {
+  const auto submap = WithStructure(*testing::SyntheticSubmap(4), SomeStructure());
+  auto v3 = SubmapCodec::Encode(*submap, Compression::kZstd, 3);
+  ASSERT_TRUE(v3.ok()) << v3.status().ToString();
+  EXPECT_EQ((*v3)[8], 3);
+  auto back = SubmapCodec::Decode(*v3);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_TRUE((*back)->structure().viewpoints.empty());
+  EXPECT_TRUE((*back)->structure().planes.empty());
+  EXPECT_EQ((*back)->points().size(), submap->points().size());
+  auto v4 = SubmapCodec::Encode(*submap);
+  ASSERT_TRUE(v4.ok());
+  EXPECT_GT(v4->size(), v3->size());
+  const auto v2 = SubmapCodec::Encode(*submap, Compression::kZstd, 2);
+  ASSERT_FALSE(v2.ok());
+  EXPECT_NE(v2.status().message().find("version 2 cannot be written"), std::string::npos);
+}
+
+TEST(SubmapCodecTest, RejectsAPlaneThatIsNotOne) {
+  SubmapStructure st = SomeStructure();
+  st.planes[1].normal = Eigen::Vector3f(2.0f, 0.0f, 0.0f);
+  auto bytes = SubmapCodec::Encode(*WithStructure(*testing::SyntheticSubmap(5), st));
+  ASSERT_TRUE(bytes.ok());
+  const auto r = SubmapCodec::Decode(*bytes);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kDataLoss);
+  EXPECT_NE(r.status().message().find("submap plane 1: normal is not a unit vector"), std::string::npos)
+      << r.status().message();
+  st = SomeStructure();
+  st.planes[0].covariance(2, 2) = -1.0f;
+  bytes = SubmapCodec::Encode(*WithStructure(*testing::SyntheticSubmap(5), st));
+  ASSERT_TRUE(bytes.ok());
+  EXPECT_NE(SubmapCodec::Decode(*bytes).status().message().find("submap plane 0: covariance"),
+            std::string::npos);
+}
+
 TEST(SubmapCodecTest, OctreeStreamValidation) {
   // Root with child 0 an inner node whose children are all occupied leaves: valid.
   std::vector<uint8_t> ok = {0x03, 0x00, 0x55, 0x55};
