@@ -117,6 +117,28 @@ void Stamp(std::vector<float>& h, int n, double half, double res, double cx, dou
   }
 }
 
+// Coordinates of (x, y) in a structure's own frame (along its length, its width), and whether they
+// lie on its footprint.
+Eigen::Vector2d StructureLocal(const double* b, double x, double y) {
+  const double yaw = b[2] * 3.14159265358979323846 / 180.0;
+  const double dx = x - b[0], dy = y - b[1];
+  return {std::cos(yaw) * dx + std::sin(yaw) * dy, -std::sin(yaw) * dx + std::cos(yaw) * dy};
+}
+bool OnFootprint(const double* b, const Eigen::Vector2d& local) {
+  return std::abs(local.x()) <= b[3] / 2 && std::abs(local.y()) <= b[4] / 2;
+}
+
+// The grid range (inclusive) covering a structure's footprint on a grid of `count` samples `step`
+// apart from -half.
+void FootprintRange(const double* b, double half, double step, int count, int* x0, int* x1, int* y0,
+                    int* y1) {
+  const double reach = std::hypot(b[3], b[4]) / 2;
+  *x0 = std::max(0, static_cast<int>(std::floor((b[0] - reach + half) / step)));
+  *x1 = std::min(count - 1, static_cast<int>(std::ceil((b[0] + reach + half) / step)));
+  *y0 = std::max(0, static_cast<int>(std::floor((b[1] - reach + half) / step)));
+  *y1 = std::min(count - 1, static_cast<int>(std::ceil((b[1] + reach + half) / step)));
+}
+
 }  // namespace
 
 TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
@@ -206,6 +228,25 @@ TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
     rocks.emplace_back(cx, cy, r, hr);
     Stamp(t.heights, n, half, res, cx, cy, r, 1.0, [&](double s) { return hr * std::sqrt(std::max(0.0, 1.0 - s * s)); });
   }
+  // Structures: every vertex on the footprint at one level, so the sides are as steep as the grid
+  // allows (one cell) and the top is flat.
+  for (size_t i = 0; i + WorldOptions::kStructureValues <= o.structures.size();
+       i += WorldOptions::kStructureValues) {
+    const double* b = &o.structures[i];
+    int x0, x1, y0, y1;
+    FootprintRange(b, half, res, n, &x0, &x1, &y0, &y1);
+    float ground = std::numeric_limits<float>::infinity();
+    std::vector<size_t> on;
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) {
+        if (!OnFootprint(b, StructureLocal(b, ix * res - half, iy * res - half))) continue;
+        const size_t k = static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix);
+        on.push_back(k);
+        ground = std::min(ground, t.heights[k]);
+      }
+    }
+    for (const size_t k : on) t.heights[k] = ground + static_cast<float>(b[5]);
+  }
   BuildAlbedo(o, rocks, &t);
   return t;
 }
@@ -242,6 +283,26 @@ void TerrainGenerator::BuildAlbedo(const WorldOptions& o, const std::vector<Eige
       for (int ix = x0; ix <= x1; ++ix) {
         const double dx = ix * tex_res - half_size - r[0], dy = iy * tex_res - half_size - r[1];
         if (dx * dx + dy * dy < r[2] * r[2]) a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n) + static_cast<size_t>(ix)] *= 0.75f;
+      }
+    }
+  }
+  // Structures are painted panels, lighter than the regolith, with darker joints every metre along
+  // both axes; the speckle of their paint gives stereo something to match on sides and tops.
+  for (size_t s = 0; s + WorldOptions::kStructureValues <= o.structures.size();
+       s += WorldOptions::kStructureValues) {
+    const double* b = &o.structures[s];
+    int x0, x1, y0, y1;
+    FootprintRange(b, half_size, tex_res, tex_n, &x0, &x1, &y0, &y1);
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) {
+        const Eigen::Vector2d l = StructureLocal(b, ix * tex_res - half_size, iy * tex_res - half_size);
+        if (!OnFootprint(b, l)) continue;
+        const double speckle = LatticeValue(seed, ix, iy, 11);
+        const double ju = std::abs(l.x() + b[3] / 2 - std::round(l.x() + b[3] / 2));
+        const double jv = std::abs(l.y() + b[4] / 2 - std::round(l.y() + b[4] / 2));
+        const bool joint = std::min(ju, jv) < 0.03;
+        a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n) + static_cast<size_t>(ix)] =
+            static_cast<float>((0.7 + 0.15 * speckle) * (joint ? 0.55 : 1.0));
       }
     }
   }

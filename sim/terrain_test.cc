@@ -191,6 +191,54 @@ TEST(TerrainTest, RaysUpIntoTheSkyMiss) {
   EXPECT_LT(t.Raycast({50, 0, 5.0}, Eigen::Vector3d(1, 0, -0.1).normalized(), 100).t, 0.0);
 }
 
+TEST(TerrainTest, StructuresAreBlocksWithLevelTopsAndSheerSides) {
+  WorldOptions w = TerrainWorld();
+  // A wall 6 m x 0.4 m, 2 m high, turned 30 deg.
+  w.structures = {1.0, -2.0, 30.0, 6.0, 0.4, 2.0};
+  ASSERT_TRUE(w.Validate().ok());
+  const Terrain plain = Terrain::Generate(TerrainWorld());
+  const Terrain t = Terrain::Generate(w);
+  const double yaw = 30.0 * M_PI / 180.0;
+  const Eigen::Vector2d along(std::cos(yaw), std::sin(yaw)), across(-std::sin(yaw), std::cos(yaw));
+  double lowest = 1e9;
+  for (double s = -2.9; s <= 2.9; s += 0.05) {
+    for (double q = -0.15; q <= 0.15; q += 0.05) {
+      const Eigen::Vector2d p = Eigen::Vector2d(1.0, -2.0) + s * along + q * across;
+      lowest = std::min(lowest, plain.Height(p.x(), p.y()));
+    }
+  }
+  // Level at 2 m over the lowest ground under it, and lit like the ground from above.
+  for (double s : {-2.5, 0.0, 2.5}) {
+    const Eigen::Vector2d p = Eigen::Vector2d(1.0, -2.0) + s * along;
+    EXPECT_GT(t.Height(p.x(), p.y()), lowest + 1.95);
+    EXPECT_LT(t.Height(p.x(), p.y()), lowest + 2.2);
+    EXPECT_GT(t.Normal(p.x(), p.y()).z(), 0.999);
+  }
+  // A level ray towards its side, 1 m up, stops within a grid cell of the side.
+  const Eigen::Vector2d foot = Eigen::Vector2d(1.0, -2.0) - 3.0 * across;
+  const Eigen::Vector3d origin(foot.x(), foot.y(), lowest + 1.0);
+  const TerrainHit hit = t.Raycast(origin, Eigen::Vector3d(across.x(), across.y(), 0.0), 10.0);
+  ASSERT_GE(hit.t, 0.0);
+  EXPECT_NEAR(hit.t, 2.8, 0.15);
+  EXPECT_LT(std::abs(hit.normal.z()), 0.2);
+  // Painted: lighter than the regolith between its joints (one runs across its middle).
+  const Eigen::Vector2d panel = Eigen::Vector2d(1.0, -2.0) + 0.5 * along;
+  EXPECT_GT(t.Albedo(panel.x(), panel.y()), 0.5f);
+  EXPECT_LT(t.Albedo(1.0, -2.0), 0.45f);
+  // Away from it the ground is unchanged.
+  EXPECT_EQ(t.Height(-6.0, 5.0), plain.Height(-6.0, 5.0));
+}
+
+TEST(TerrainTest, StructuresOfTheWrongShapeAreRefused) {
+  WorldOptions w = TerrainWorld();
+  w.structures = {1.0, -2.0, 30.0, 6.0, 0.4};
+  EXPECT_NE(w.Validate().message().find("six values per structure"), std::string::npos);
+  w.structures = {1.0, -2.0, 30.0, 6.0, 0.4, 0.0};
+  EXPECT_NE(w.Validate().message().find("structure 0: height"), std::string::npos);
+  w.structures = {9.5, 0.0, 0.0, 4.0, 1.0, 1.0};
+  EXPECT_NE(w.Validate().message().find("structure 0: must lie"), std::string::npos);
+}
+
 TEST(TerrainTest, TheLanderStandsOnALevelBoulderFreeSite) {
   // Seeds where the default world's lander would stand on a crater wall or among boulders.
   for (int64_t seed : {1, 2, 3}) {

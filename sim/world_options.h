@@ -2,8 +2,10 @@
 // The simulated world as described by a small YAML file (`cairn sim --world`). Everything is
 // derived from these numbers and the seed, so a world file plus a seed reproduces a mission.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "common/options_visitor.h"
@@ -31,6 +33,13 @@ struct WorldOptions {
   // A rover's tag on its deck facing up, for the multicopter above (larger: it is seen from 3-5 m);
   // 0: none.
   double roof_tag_size = 0.4;
+  // Man-made structures (a habitat, walls, crates, a lander's body): blocks with vertical sides and
+  // a level top on the ground, six values each: x, y (m), yaw (deg), length, width, height (m). The
+  // top stands `height` above the lowest ground under it. Sides square to the height grid (yaw a
+  // multiple of 90 deg) are planes; at other angles they come out as steps of one grid cell.
+  std::vector<double> structures;
+  static constexpr size_t kStructureValues = 6;
+  static constexpr size_t kMaxStructures = 64;
 
   void Visit(OptionsVisitor& v) {
     v.Number("size", size, 10.0, 400.0, "m");
@@ -48,6 +57,8 @@ struct WorldOptions {
     v.Number("landing_site", landing_site, 0.0, 50.0, "m");
     v.Number("tag_size", tag_size, 0.02, 2.0, "m");
     v.Number("roof_tag_size", roof_tag_size, 0.0, 0.4, "m");
+    v.Numbers("structures", structures, 0, kStructureValues * kMaxStructures, -400.0, 400.0,
+              "groups of x y (m), yaw (deg), length width height (m)");
   }
   Status Validate() const {
     if (size / resolution > 8000.0) {
@@ -56,6 +67,22 @@ struct WorldOptions {
     if (lander.size() == 1) return InvalidArgumentError("lander needs x and y (or nothing)");
     if (lander.size() == 2 && (std::abs(lander[0]) > size / 2 - 2 || std::abs(lander[1]) > size / 2 - 2)) {
       return InvalidArgumentError("lander must lie at least 2 m inside the world");
+    }
+    if (structures.size() % kStructureValues != 0) {
+      return InvalidArgumentError(
+          "structures needs six values per structure (x, y, yaw, length, width, height), got " +
+          std::to_string(structures.size()));
+    }
+    for (size_t i = 0; i < structures.size(); i += kStructureValues) {
+      const double* b = &structures[i];
+      const std::string which = "structure " + std::to_string(i / kStructureValues) + ": ";
+      if (std::hypot(b[3], b[4]) / 2 + std::max(std::abs(b[0]), std::abs(b[1])) > size / 2 - 1) {
+        return InvalidArgumentError(which + "must lie at least 1 m inside the world");
+      }
+      if (!(b[3] >= 2 * resolution && b[4] >= 2 * resolution && b[3] <= 100 && b[4] <= 100)) {
+        return InvalidArgumentError(which + "length and width must be 2 grid cells to 100 m");
+      }
+      if (!(b[5] > 0.0 && b[5] <= 20.0)) return InvalidArgumentError(which + "height must be in (0, 20] m");
     }
     return Status::Ok();
   }
