@@ -100,8 +100,34 @@ int RunInfo(const std::vector<std::string>& files) {
   return 0;
 }
 
+// Planes extracted again with the default options and one camera's error model, beside those
+// stored: for files written before planes were (version 3) or under other options.
+int RunPlanes(const std::vector<std::string>& files, double focal_px, double baseline) {
+  const PlaneOptions options;
+  PlaneExtractor extractor(options,
+                           StereoErrorModel(focal_px, baseline, MappingOptions{}.depth.pixel_error_px));
+  for (const std::string& f : files) {
+    auto s = SubmapCodec::ReadFile(f);
+    if (!s.ok()) return Fail(s.status());
+    PlaneExtractor::Stats stats;
+    const auto t0 = Clock::now();
+    const std::vector<SubmapPlane> planes =
+        extractor.Extract((*s)->points(), (*s)->structure().viewpoints, &stats);
+    std::printf("%s: %zu planes in %.2f ms (%zu stored); %zu cubes, %zu planar, %zu points skipped\n",
+                f.c_str(), planes.size(), Ms(t0, Clock::now()), (*s)->structure().planes.size(), stats.cubes,
+                stats.planar_cubes, stats.skipped_points);
+    for (const SubmapPlane& p : planes) {
+      std::printf("    normal (%.3f %.3f %.3f) offset %.3f m, %.1f m^2, %u points, extent %.1f x %.1f m\n",
+                  p.normal.x(), p.normal.y(), p.normal.z(), p.offset, p.area, p.points, p.max.x() - p.min.x(),
+                  p.max.y() - p.min.y());
+    }
+  }
+  return 0;
+}
+
 constexpr const char* kMapUsage =
     "usage: cairn map info SUBMAP...\n"
+    "       cairn map planes [--focal PX (1080)] [--baseline M (0.09)] SUBMAP...\n"
     "       cairn map export SUBMAP [--cloud OUT.pcd|OUT.ply] [--octree OUT.bt|OUT.ot]\n"
     "       cairn map compose [--cloud OUT.pcd|.ply] [--octree OUT.bt|.ot] SUBMAP[@x,y,z,yaw_deg]...\n";
 
@@ -116,10 +142,19 @@ int RunMap(const CommandArgs& args) {
   }
   const std::string verb = a[0];
   std::string cloud_out, octree_out;
+  double focal_px = 1080.0, baseline = 0.09;  // the rover's cameras
   std::vector<std::string> inputs;
   for (size_t i = 1; i < a.size(); ++i) {
     if ((a[i] == "--cloud" || a[i] == "--octree") && i + 1 < a.size()) {
       (a[i] == "--cloud" ? cloud_out : octree_out) = a[i + 1];
+      ++i;
+    } else if ((a[i] == "--focal" || a[i] == "--baseline") && i + 1 < a.size()) {
+      double v;
+      if (!ParseNumber(a[i + 1], &v) || !(v > 0.0)) {
+        std::fprintf(stderr, "cairn map: %s needs a positive number\n", a[i].c_str());
+        return 2;
+      }
+      (a[i] == "--focal" ? focal_px : baseline) = v;
       ++i;
     } else if (a[i].rfind("--", 0) == 0) {
       std::fprintf(stderr, "cairn map: unknown option %s\n%s", a[i].c_str(), kMapUsage);
@@ -133,6 +168,7 @@ int RunMap(const CommandArgs& args) {
     return 2;
   }
   if (verb == "info") return RunInfo(inputs);
+  if (verb == "planes") return RunPlanes(inputs, focal_px, baseline);
   if (verb == "export") {
     if (inputs.size() != 1) return std::fputs(kMapUsage, stderr), 2;
     auto s = SubmapCodec::ReadFile(inputs[0]);

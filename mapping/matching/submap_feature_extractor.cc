@@ -8,8 +8,9 @@
 namespace cairn {
 
 size_t SubmapFeatures::memory_bytes() const {
-  return sizeof(*this) + HeapBytes(keypoints.points, keypoints.known_fraction, described.points, described.descriptors,
-                                   described.frames, described.keypoint_index, cloud, cloud_grey);
+  return sizeof(*this) + HeapBytes(keypoints.points, keypoints.known_fraction, described.points,
+                                   described.descriptors, described.frames, described.keypoint_index, cloud,
+                                   cloud_grey, planes);
 }
 
 SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
@@ -37,6 +38,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
     return f;
   }
 
+  f.planes = submap.structure().planes;
   const auto describe_start = std::chrono::steady_clock::now();
   GravityShotDescriptor descriptor(submap.points(), options_.descriptor, frame_);
   f.described = descriptor.ComputeAll(f.keypoints.points);

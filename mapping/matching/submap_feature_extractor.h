@@ -38,6 +38,7 @@ struct SubmapFeatures {
   std::vector<float> cloud_grey;        // each cloud point's grey level (mean of r, g, b)
   // xy extent of the finite obstacle points (submap frame); empty when there are none.
   Eigen::AlignedBox2d obstacle_box_xy;
+  std::vector<SubmapPlane> planes;  // the submap's planar faces (empty when unsuitable)
   double keypoint_ms = 0.0;    // keypoints, known-space filter and suitability
   double descriptor_ms = 0.0;  // descriptors (zero for an unsuitable submap)
 

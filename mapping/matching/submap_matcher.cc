@@ -379,7 +379,45 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   }
   r.times.icp_ms = MillisecondsSince(stage);
 
-  // Where the descriptors gave no hypothesis that held, the grey levels seen from above are
+  // A hypothesis from another source than the descriptors: the gate, then the grey levels, which
+  // must agree (undecided is refused too: no keypoints vouch for it), then the refinement.
+  const auto Alternative = [&](const FourDofTransform& T_a_b, const char* kind, const std::string& source,
+                               double min_match_ncc) {
+    Hypothesis h;
+    h.T_a_b = T_a_b;
+    h.T_full = h.T_a_b.ToIsometry();
+    std::string why;
+    if (prior.has_value() && !WithinGate(h.T_a_b, *prior, &why)) {
+      rejections.Add(Format("%ss outside the gate", kind), Format("%s ", kind) + why);
+      return false;
+    }
+    if (Judge(options_.min_hypothesis_ncc, h.T_a_b, &why) != Verdict::kAgree) {
+      rejections.Add(Format("%ss whose grey levels disagree", kind), Format("%s: ", kind) + why);
+      return false;
+    }
+    h.grey_agreed = true;
+    const auto icp_start = Clock::now();
+    const bool matched = Refined(h, source, min_match_ncc);
+    r.times.icp_ms += MillisecondsSince(icp_start);
+    return matched;
+  };
+
+  // Where the descriptors gave no hypothesis that held, pairings of planar faces (cheap, few).
+  // Faces of man-made things repeat (a crate's four sides): the grey levels tell which is which.
+  if (!six && options_.planes.enabled && !a.planes.empty() && !b.planes.empty()) {
+    stage = Clock::now();
+    const std::vector<PlaneHypothesis> paired = PlaneHypotheses(options_.planes).Find(a.planes, b.planes);
+    r.times.planes_ms = MillisecondsSince(stage);
+    for (const PlaneHypothesis& candidate : paired) {
+      ++r.plane_hypotheses;
+      if (Alternative(candidate.T_a_b, "plane pairing",
+                      Format("planar faces paired (smallest %.1f m^2)", candidate.area),
+                      options_.min_match_ncc))
+        return finish(MatchStatus::kMatched, r.reason);
+    }
+  }
+
+  // Where neither gave a hypothesis that held, the grey levels seen from above are
   // searched for one (4-DoF only: the search turns about gravity).
   if (!six && options_.grey_search.enabled) {
     stage = Clock::now();
@@ -400,28 +438,11 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
         rejections.Add("grey-level search without a candidate", "grey-level search: no candidate");
       for (const GreyLevelCandidate& candidate : found->candidates) {
         ++r.searched;
-        Hypothesis h;
-        h.T_a_b = candidate.T_a_b;
-        h.T_full = h.T_a_b.ToIsometry();
-        std::string why;
-        if (prior.has_value() && !WithinGate(h.T_a_b, *prior, &why)) {
-          rejections.Add("searched candidates outside the gate", "searched candidate " + why);
-          continue;
-        }
-        // Found by the grey levels, so only they can vouch for it: undecided is refused too.
-        if (Judge(options_.min_hypothesis_ncc, h.T_a_b, &why) != Verdict::kAgree) {
-          rejections.Add("searched candidates whose grey levels disagree", "searched candidate: " + why);
-          continue;
-        }
-        h.grey_agreed = true;
-        const auto icp_start = Clock::now();
-        const bool matched =
-            Refined(h,
-                    Format("grey-level search, raster correlation %.3f over %lld cells",
-                           candidate.correlation, static_cast<long long>(candidate.overlap_cells)),
-                    std::max(options_.min_match_ncc, options_.grey_search.min_match_ncc));
-        r.times.icp_ms += MillisecondsSince(icp_start);
-        if (matched) return finish(MatchStatus::kMatched, r.reason);
+        if (Alternative(candidate.T_a_b, "searched candidate",
+                        Format("grey-level search, raster correlation %.3f over %lld cells",
+                               candidate.correlation, static_cast<long long>(candidate.overlap_cells)),
+                        std::max(options_.min_match_ncc, options_.grey_search.min_match_ncc)))
+          return finish(MatchStatus::kMatched, r.reason);
       }
     }
   }

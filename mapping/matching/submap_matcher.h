@@ -32,6 +32,7 @@
 #include "mapping/matching/grey_level_search.h"
 #include "mapping/matching/hough_voting.h"
 #include "mapping/matching/photometric_agreement.h"
+#include "mapping/matching/plane_hypotheses.h"
 #include "mapping/matching/submap_feature_extractor.h"
 
 namespace cairn {
@@ -43,6 +44,9 @@ struct SubmapMatcherOptions {
   IcpOptions icp;
   // Hypotheses from the grey levels seen from above where the descriptors' fail (4-DoF only).
   GreyLevelSearchOptions grey_search;
+  // Hypotheses from the submaps' planar faces where the descriptors' fail, before the search
+  // (4-DoF only).
+  PlaneHypothesisOptions planes;
   // Hypotheses and the refined match must lie within gate_sigmas standard deviations of the
   // relative estimate in each of x, y, z and yaw (thesis: 2, on x, y, z). The floors stand for the
   // matcher's own error, so a relative estimate known better than the matcher cannot veto it.
@@ -90,6 +94,7 @@ struct SubmapMatcherOptions {
     v.Section("ransac", ransac);
     v.Section("icp", icp);
     v.Section("grey_search", grey_search);
+    v.Section("planes", planes);
     v.Number("gate_sigmas", gate_sigmas, 0.5, 100.0, "");
     v.Number("gate_floor_translation", gate_floor_translation, 0.0, 100.0, "m");
     v.Number("gate_floor_yaw", gate_floor_yaw, 0.0, 3.2, "rad");
@@ -129,6 +134,7 @@ struct MatchStageTimes {
   double ransac_ms = 0.0;  // all clusters, with the gate and spread checks
   double icp_ms = 0.0;     // every refinement, the searched candidates' too
   double search_ms = 0.0;  // the grey-level search, when it ran
+  double planes_ms = 0.0;  // pairing the planar faces, when it ran
   double total_ms = 0.0;
 };
 
@@ -146,6 +152,7 @@ struct SubmapMatchResult {
   size_t photometric_rejected = 0;  // hypotheses and refinements whose grey levels disagree
   size_t refined = 0;          // hypotheses handed to the ICP
   size_t searched = 0;         // candidates of the grey-level search (not in the counts above)
+  size_t plane_hypotheses = 0;  // from the planar faces (not in the counts above either)
   int dof = 4;                 // 6: the variant without gravity
   Eigen::Isometry3d T_a_b_full = Eigen::Isometry3d::Identity();  // = T_a_b in 4-DoF
   double tilt = 0.0;           // rad; angle between A's z and B's z under T_a_b_full
