@@ -61,10 +61,7 @@ PlaneExtractor::PlaneExtractor(const PlaneOptions& options, const StereoErrorMod
       index_(4096) {}
 
 double PlaneExtractor::NormalSigma(const Cube& c, const Eigen::Vector3d& normal) const {
-  const double cos2 = std::min(1.0, std::pow(normal.dot(c.sight), 2));
-  const double along = error_model_.DepthError(c.range);
-  const double across = c.range * error_model_.pixel_error_px() / error_model_.focal_px();
-  return std::max(kMinSigma, std::sqrt(along * along * cos2 + across * across * (1.0 - cos2)));
+  return std::sqrt(std::max(kMinSigma * kMinSigma, normal.dot(PointError(c) * normal)));
 }
 
 Eigen::Matrix3d PlaneExtractor::PointError(const Cube& c) const {
@@ -260,8 +257,8 @@ std::vector<SubmapPlane> PlaneExtractor::Extract(std::span<const CloudPoint> poi
       }
     });
   }
-  planes_.assign(grown.size(), Moments{});
-  for (size_t k = 0; k < grown.size(); ++k) planes_[k].ref = -grown[k].offset * grown[k].normal;
+  plane_moments_.assign(grown.size(), Moments{});
+  for (size_t k = 0; k < grown.size(); ++k) plane_moments_[k].ref = -grown[k].offset * grown[k].normal;
   for (size_t i = 0; i < points.size(); ++i) {
     int32_t& at = point_cube_[i];
     if (at < 0) continue;
@@ -272,53 +269,49 @@ std::vector<SubmapPlane> PlaneExtractor::Extract(std::span<const CloudPoint> poi
     const Eigen::Vector3d p = points[i].p.cast<double>();
     const double sigma = NormalSigma(c, f.normal);
     if (std::abs(f.normal.dot(p) + f.offset) > Tolerance(sigma)) continue;
-    planes_[static_cast<size_t>(c.plane)].Add(p, 1.0 / (sigma * sigma), PointError(c));
+    plane_moments_[static_cast<size_t>(c.plane)].Add(p, 1.0 / (sigma * sigma), PointError(c));
     at = c.plane;  // from here on the point's plane
   }
 
+  // Planes whose fit fails keep points == 0 and are dropped at the end.
   std::vector<SubmapPlane> planes(grown.size());
-  std::vector<bool> kept(grown.size(), false);
   for (size_t k = 0; k < grown.size(); ++k) {
     Fitted f;
-    if (!Fit(planes_[k], grown[k].normal, &f)) continue;
+    if (!Fit(plane_moments_[k], grown[k].normal, &f)) continue;
     const Eigen::FullPivLU<Eigen::Matrix3d> lu(f.information);
     if (!lu.isInvertible()) continue;
     // Points scattering more than the stereo error says (rough or slightly curved faces) widen it.
-    const double dof = std::max(1.0, planes_[k].n - 3.0);
+    const double dof = std::max(1.0, plane_moments_[k].n - 3.0);
     const Eigen::Matrix3d covariance = lu.inverse() * std::max(1.0, f.chi2 / dof);
     if (!covariance.allFinite()) continue;
     SubmapPlane& p = planes[k];
     p.normal = f.normal.cast<float>();
     p.offset = static_cast<float>(f.offset);
     p.covariance = covariance.cast<float>();
-    p.points = static_cast<uint32_t>(planes_[k].n);
+    p.points = static_cast<uint32_t>(plane_moments_[k].n);
     p.area = static_cast<float>(areas[k]);
-    p.centroid = (planes_[k].ref + planes_[k].unweighted / planes_[k].n).cast<float>();
+    p.centroid = (plane_moments_[k].ref + plane_moments_[k].unweighted / plane_moments_[k].n).cast<float>();
     p.min = Eigen::Vector2f::Constant(std::numeric_limits<float>::infinity());
     p.max = -p.min;
-    kept[k] = true;
   }
   // Extents, from the points themselves.
   std::vector<Eigen::Vector3f> us(planes.size()), vs(planes.size());
   for (size_t k = 0; k < planes.size(); ++k) SubmapPlane::Axes(planes[k].normal, &us[k], &vs[k]);
   for (size_t i = 0; i < points.size(); ++i) {
     const int32_t k = point_cube_[i];
-    if (k < 0 || !kept[static_cast<size_t>(k)]) continue;
+    if (k < 0 || planes[static_cast<size_t>(k)].points == 0) continue;
     SubmapPlane& p = planes[static_cast<size_t>(k)];
     const Eigen::Vector3f d = points[i].p - p.centroid;
     const Eigen::Vector2f uv(us[static_cast<size_t>(k)].dot(d), vs[static_cast<size_t>(k)].dot(d));
     p.min = p.min.cwiseMin(uv);
     p.max = p.max.cwiseMax(uv);
   }
-  std::vector<SubmapPlane> out;
-  for (size_t k = 0; k < planes.size(); ++k) {
-    if (kept[k]) out.push_back(planes[k]);
-  }
-  std::stable_sort(out.begin(), out.end(),
+  std::erase_if(planes, [](const SubmapPlane& p) { return p.points == 0; });
+  std::stable_sort(planes.begin(), planes.end(),
                    [](const SubmapPlane& a, const SubmapPlane& b) { return a.points > b.points; });
-  if (out.size() > static_cast<size_t>(options_.max_planes))
-    out.resize(static_cast<size_t>(options_.max_planes));
-  return out;
+  if (planes.size() > static_cast<size_t>(options_.max_planes))
+    planes.resize(static_cast<size_t>(options_.max_planes));
+  return planes;
 }
 
 }  // namespace cairn

@@ -95,7 +95,7 @@ class PlaneExtractor {
   std::vector<uint64_t> keys_;  // of each cube
   std::vector<int32_t> point_cube_;
   std::vector<int> order_, queue_, members_;
-  std::vector<Moments> planes_;  // per plane, from its points
+  std::vector<Moments> plane_moments_;  // per plane, from its points
 };
 
 }  // namespace cairn

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <utility>
 #include <vector>
 
@@ -120,7 +121,7 @@ void Stamp(std::vector<float>& h, int n, double half, double res, double cx, dou
 // Coordinates of (x, y) in a structure's own frame (along its length, its width), and whether they
 // lie on its footprint.
 Eigen::Vector2d StructureLocal(const double* b, double x, double y) {
-  const double yaw = b[2] * 3.14159265358979323846 / 180.0;
+  const double yaw = b[2] * std::numbers::pi / 180.0;
   const double dx = x - b[0], dy = y - b[1];
   return {std::cos(yaw) * dx + std::sin(yaw) * dy, -std::sin(yaw) * dx + std::cos(yaw) * dy};
 }
@@ -128,15 +129,21 @@ bool OnFootprint(const double* b, const Eigen::Vector2d& local) {
   return std::abs(local.x()) <= b[3] / 2 && std::abs(local.y()) <= b[4] / 2;
 }
 
-// The grid range (inclusive) covering a structure's footprint on a grid of `count` samples `step`
-// apart from -half.
-void FootprintRange(const double* b, double half, double step, int count, int* x0, int* x1, int* y0,
-                    int* y1) {
+// Calls f(ix, iy, local) for every sample of a grid of `count` x `count` samples `step` apart from
+// -half that lies on a structure's footprint (local: its coordinates in the structure's frame).
+template <class F>
+void ForEachOnFootprint(const double* b, double half, double step, int count, F&& f) {
   const double reach = std::hypot(b[3], b[4]) / 2;
-  *x0 = std::max(0, static_cast<int>(std::floor((b[0] - reach + half) / step)));
-  *x1 = std::min(count - 1, static_cast<int>(std::ceil((b[0] + reach + half) / step)));
-  *y0 = std::max(0, static_cast<int>(std::floor((b[1] - reach + half) / step)));
-  *y1 = std::min(count - 1, static_cast<int>(std::ceil((b[1] + reach + half) / step)));
+  const int x0 = std::max(0, static_cast<int>(std::floor((b[0] - reach + half) / step)));
+  const int x1 = std::min(count - 1, static_cast<int>(std::ceil((b[0] + reach + half) / step)));
+  const int y0 = std::max(0, static_cast<int>(std::floor((b[1] - reach + half) / step)));
+  const int y1 = std::min(count - 1, static_cast<int>(std::ceil((b[1] + reach + half) / step)));
+  for (int iy = y0; iy <= y1; ++iy) {
+    for (int ix = x0; ix <= x1; ++ix) {
+      const Eigen::Vector2d local = StructureLocal(b, ix * step - half, iy * step - half);
+      if (OnFootprint(b, local)) f(ix, iy, local);
+    }
+  }
 }
 
 }  // namespace
@@ -233,18 +240,13 @@ TerrainGrids TerrainGenerator::Generate(const WorldOptions& o) {
   for (size_t i = 0; i + WorldOptions::kStructureValues <= o.structures.size();
        i += WorldOptions::kStructureValues) {
     const double* b = &o.structures[i];
-    int x0, x1, y0, y1;
-    FootprintRange(b, half, res, n, &x0, &x1, &y0, &y1);
     float ground = std::numeric_limits<float>::infinity();
     std::vector<size_t> on;
-    for (int iy = y0; iy <= y1; ++iy) {
-      for (int ix = x0; ix <= x1; ++ix) {
-        if (!OnFootprint(b, StructureLocal(b, ix * res - half, iy * res - half))) continue;
-        const size_t k = static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix);
-        on.push_back(k);
-        ground = std::min(ground, t.heights[k]);
-      }
-    }
+    ForEachOnFootprint(b, half, res, n, [&](int ix, int iy, const Eigen::Vector2d&) {
+      const size_t k = static_cast<size_t>(iy) * static_cast<size_t>(n) + static_cast<size_t>(ix);
+      on.push_back(k);
+      ground = std::min(ground, t.heights[k]);
+    });
     for (const size_t k : on) t.heights[k] = ground + static_cast<float>(b[5]);
   }
   BuildAlbedo(o, rocks, &t);
@@ -291,20 +293,14 @@ void TerrainGenerator::BuildAlbedo(const WorldOptions& o, const std::vector<Eige
   for (size_t s = 0; s + WorldOptions::kStructureValues <= o.structures.size();
        s += WorldOptions::kStructureValues) {
     const double* b = &o.structures[s];
-    int x0, x1, y0, y1;
-    FootprintRange(b, half_size, tex_res, tex_n, &x0, &x1, &y0, &y1);
-    for (int iy = y0; iy <= y1; ++iy) {
-      for (int ix = x0; ix <= x1; ++ix) {
-        const Eigen::Vector2d l = StructureLocal(b, ix * tex_res - half_size, iy * tex_res - half_size);
-        if (!OnFootprint(b, l)) continue;
-        const double speckle = LatticeValue(seed, ix, iy, 11);
-        const double ju = std::abs(l.x() + b[3] / 2 - std::round(l.x() + b[3] / 2));
-        const double jv = std::abs(l.y() + b[4] / 2 - std::round(l.y() + b[4] / 2));
-        const bool joint = std::min(ju, jv) < 0.03;
-        a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n) + static_cast<size_t>(ix)] =
-            static_cast<float>((0.7 + 0.15 * speckle) * (joint ? 0.55 : 1.0));
-      }
-    }
+    ForEachOnFootprint(b, half_size, tex_res, tex_n, [&](int ix, int iy, const Eigen::Vector2d& l) {
+      const double speckle = LatticeValue(seed, ix, iy, 11);
+      const double ju = std::abs(l.x() + b[3] / 2 - std::round(l.x() + b[3] / 2));
+      const double jv = std::abs(l.y() + b[4] / 2 - std::round(l.y() + b[4] / 2));
+      const bool joint = std::min(ju, jv) < 0.03;
+      a[static_cast<size_t>(iy) * static_cast<size_t>(tex_n) + static_cast<size_t>(ix)] =
+          static_cast<float>((0.7 + 0.15 * speckle) * (joint ? 0.55 : 1.0));
+    });
   }
   t->grain.resize(256 * 256);
   for (size_t i = 0; i < t->grain.size(); ++i) {

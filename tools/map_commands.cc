@@ -75,6 +75,15 @@ int Fail(const Status& s) {
   return 1;
 }
 
+void PrintPlane(const SubmapPlane& p) {
+  std::printf(
+      "    normal (%.3f %.3f %.3f) offset %.3f m, %.1f m^2, %u points, extent %.1f x %.1f m, sigma %.2f deg "
+      "%.3f m\n",
+      p.normal.x(), p.normal.y(), p.normal.z(), p.offset, p.area, p.points, p.max.x() - p.min.x(),
+      p.max.y() - p.min.y(), std::sqrt(std::max(p.covariance(0, 0), p.covariance(1, 1))) * 180.0 / M_PI,
+      std::sqrt(p.covariance(2, 2)));
+}
+
 int RunInfo(const std::vector<std::string>& files) {
   for (const std::string& f : files) {
     auto s = SubmapCodec::ReadFile(f);
@@ -90,12 +99,7 @@ int RunInfo(const std::vector<std::string>& files) {
                 free_leaves, md.options.octree_resolution);
     const SubmapStructure& st = m.structure();
     std::printf("  %zu viewpoints, %zu planes\n", st.viewpoints.size(), st.planes.size());
-    for (const SubmapPlane& p : st.planes) {
-      std::printf("    normal (%.3f %.3f %.3f) offset %.3f m, %.1f m^2, %u points, sigma %.2f deg %.3f m\n",
-                  p.normal.x(), p.normal.y(), p.normal.z(), p.offset, p.area, p.points,
-                  std::sqrt(std::max(p.covariance(0, 0), p.covariance(1, 1))) * 180.0 / M_PI,
-                  std::sqrt(p.covariance(2, 2)));
-    }
+    for (const SubmapPlane& p : st.planes) PrintPlane(p);
   }
   return 0;
 }
@@ -116,11 +120,7 @@ int RunPlanes(const std::vector<std::string>& files, double focal_px, double bas
     std::printf("%s: %zu planes in %.2f ms (%zu stored); %zu cubes, %zu planar, %zu points skipped\n",
                 f.c_str(), planes.size(), Ms(t0, Clock::now()), (*s)->structure().planes.size(), stats.cubes,
                 stats.planar_cubes, stats.skipped_points);
-    for (const SubmapPlane& p : planes) {
-      std::printf("    normal (%.3f %.3f %.3f) offset %.3f m, %.1f m^2, %u points, extent %.1f x %.1f m\n",
-                  p.normal.x(), p.normal.y(), p.normal.z(), p.offset, p.area, p.points, p.max.x() - p.min.x(),
-                  p.max.y() - p.min.y());
-    }
+    for (const SubmapPlane& p : planes) PrintPlane(p);
   }
   return 0;
 }
@@ -407,8 +407,7 @@ int RunBenchMap(const CommandArgs& args) {
     }
     std::printf(
         "  plane extraction (mapping.planes): median %.2f ms for %zu points, %zu planes (largest %u points); "
-        "one "
-        "hashing pass %.2f ms (ratio %.1fx)  target <= 10 ms per submap\n",
+        "one hashing pass %.2f ms (ratio %.1fx)  target <= 10 ms per submap\n",
         Median(t_planes), submap->points().size(), planes.size(), planes.empty() ? 0u : planes[0].points,
         Median(t_hash), Median(t_planes) / std::max(1e-9, Median(t_hash)));
   }

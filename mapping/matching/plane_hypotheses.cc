@@ -10,7 +10,8 @@
 namespace cairn {
 namespace {
 
-double Heading(const Eigen::Vector3f& n) {
+template <class Vector>
+double Heading(const Vector& n) {
   return std::atan2(static_cast<double>(n.y()), static_cast<double>(n.x()));
 }
 
@@ -72,8 +73,7 @@ std::vector<PlaneHypothesis> PlaneHypotheses::Find(const std::vector<SubmapPlane
               if (std::abs(pk.normal.z() - bi.normal.z()) > max_dz ||
                   std::abs(pl.normal.z() - bj.normal.z()) > max_dz)
                 continue;
-              const double hk = std::atan2(pk.normal.y(), pk.normal.x()),
-                           hl = std::atan2(pl.normal.y(), pl.normal.x());
+              const double hk = Heading(pk.normal), hl = Heading(pl.normal);
               if (std::abs(WrapAngle(WrapAngle(hl - hk) - angle_b)) > mismatch) continue;
               const double yaw1 = WrapAngle(hk - Heading(bi.normal)),
                            yaw2 = WrapAngle(hl - Heading(bj.normal));
