@@ -11,23 +11,24 @@
 #include "common/heap_bytes.h"
 #include "common/options_yaml_writer.h"
 #include "daemon/comms/comms_stage.h"
-#include "daemon/pipeline/pipeline.h"
-#include "daemon/run_summary.h"
-#include "daemon/submap_index.h"
 #include "daemon/detections_csv.h"
 #include "daemon/earlier_runs.h"
 #include "daemon/heap_policy.h"
+#include "daemon/pipeline/pipeline.h"
+#include "daemon/run_summary.h"
 #include "daemon/simulated_robot.h"
+#include "daemon/submap_index.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/team_summary.h"
 #include "drivers/aravis_stereo_camera.h"
 #include "drivers/can_wheel_decoder.h"
 #include "drivers/gpiod_trigger.h"
+#include "drivers/iio_imu_driver.h"
+#include "drivers/nmea_gnss_driver.h"
 #include "drivers/replay/euroc_replay.h"
 #include "drivers/replay/mcap_replay.h"
 #include "drivers/socketcan_wheel_driver.h"
 #include "drivers/trigger_frame_stamper.h"
-#include "drivers/iio_imu_driver.h"
 #include "drivers/xsens_imu_driver.h"
 #include "estimation/graph/g2o_io.h"
 
@@ -147,6 +148,22 @@ Status Cairnd::Prepare() {
   if (options_.trigger.driver == TriggerDriverKind::kGpiod && options_.source == SourceKind::kLive) {
     sources_.push_back(std::make_unique<GpiodTrigger>(options_.trigger.gpiod));
     trigger_source_ = sources_.back().get();
+  }
+  // And the GNSS receiver, likewise.
+  if (options_.gnss.driver == GnssDriverKind::kNmea && options_.source == SourceKind::kLive) {
+    sources_.push_back(std::make_unique<NmeaGnssDriver>(options_.gnss.nmea));
+  }
+  const bool fixes_come =
+      (options_.source == SourceKind::kLive && options_.gnss.driver != GnssDriverKind::kNone) ||
+      (options_.source == SourceKind::kSim && options_.sim.gnss.enabled);
+  const bool fixes_used = options_.graph.enabled && options_.graph.gnss.enabled;
+  if (fixes_come != fixes_used) {
+    spdlog::warn("{}: {}", config_path_,
+                 fixes_come
+                     ? "GNSS fixes come (gnss.driver or sim.gnss.enabled) but graph.gnss.enabled is false: "
+                       "they are not used"
+                     : "graph.gnss.enabled but no GNSS source (gnss.driver for live, sim.gnss.enabled): "
+                       "the graph gets no fixes");
   }
   if (options_.source == SourceKind::kLive && !options_.cameras.enabled) {
     // Say what a live robot lacks, once, before it runs without it.

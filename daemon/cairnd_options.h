@@ -12,13 +12,14 @@
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/executor_options.h"
 #include "daemon/pipeline/graph_stage_options.h"
+#include "daemon/pipeline/mapping_stage_options.h"
 #include "daemon/pipeline/robot_detection_options.h"
 #include "daemon/pipeline/submap_matching_options.h"
-#include "daemon/pipeline/mapping_stage_options.h"
 #include "daemon/telemetry/live_stream_options.h"
 #include "daemon/telemetry/recording_options.h"
 #include "drivers/camera_device_options.h"
 #include "drivers/can_wheel_options.h"
+#include "drivers/gnss_device_options.h"
 #include "drivers/imu_device_options.h"
 #include "drivers/replay/replay_options.h"
 #include "drivers/trigger_device_options.h"
@@ -109,6 +110,7 @@ struct CairndOptions {
   ImuDeviceOptions imu;
   CameraDeviceOptions cameras;
   TriggerDeviceOptions trigger;
+  GnssDeviceOptions gnss;
   ExecutorsOptions executors;
   QueueOptions queues;
   DaemonOptions daemon;
@@ -135,6 +137,7 @@ struct CairndOptions {
     v.Section("imu", imu);
     v.Section("cameras", cameras);
     v.Section("trigger", trigger);
+    v.Section("gnss", gnss);
     v.Section("executors", executors);
     v.Section("queues", queues);
     v.Section("daemon", daemon);

@@ -3,7 +3,9 @@
 #include "common/heap_bytes.h"
 #include "common/json_writer.h"
 
+#include <cmath>
 #include <filesystem>
+#include <numbers>
 
 namespace cairn {
 namespace {
@@ -172,6 +174,19 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("solves", g.solves).Field("reinitializations", g.reinitializations);
     j.Field("unconnected_variables", g.unconnected_variables);
     j.Field("chi2", g.chi2);
+    j.Key("gnss").BeginObject();
+    j.Field("fixes", g.gnss_fixes).Field("factors", g.gnss_factors).Field("refused", g.gnss_refused);
+    j.Field("unplaced", g.gnss_unplaced).Field("pending", g.gnss_pending);
+    // Where the datum's east-north-up frame lies in the graph's world: the map's geo-reference.
+    if (Eigen::Isometry3d T_world_enu; graph->Datum(&T_world_enu)) {
+      const Eigen::Vector3d t = T_world_enu.translation();
+      const Eigen::Matrix3d R = T_world_enu.linear();
+      j.Key("T_world_enu").BeginObject();
+      j.Field("x", t.x()).Field("y", t.y()).Field("z", t.z());
+      j.Field("yaw_deg", std::atan2(R(1, 0), R(0, 0)) * 180.0 / std::numbers::pi);
+      j.EndObject();
+    }
+    j.EndObject();
     j.Key("first_errors").BeginArray();
     for (const auto& e : g.errors) j.String(e);
     j.EndArray();

@@ -94,7 +94,8 @@ Expected<SimulatedRobot> OpenSimulatedRobot(const CairndOptions& options, const 
   for (const sim::ImuTruth& s : shared->ImuStream(index)) {
     robot.ground_truth.poses.push_back({s.sample.time, s.state.T_world_body});
   }
-  robot.source = std::make_unique<sim::SimulatorSource>(shared, index, options.replay);
+  robot.source = std::make_unique<sim::SimulatorSource>(shared, index, options.replay, options.sim.gnss,
+                                                        static_cast<uint64_t>(options.sim.seed));
   return robot;
 }
 

@@ -109,6 +109,7 @@ class StereoSink final : public SensorSink {
   void OnImu(const ImuSample&) override {}
   void OnWheelOdometry(const WheelOdometrySample&) override {}
   void OnTrigger(const TriggerEvent&) override {}
+  void OnGnss(const GnssFix&) override {}
   void OnStereo(const StereoFrame& f) override {
     Seen s;
     s.arrival = clock_.Now();

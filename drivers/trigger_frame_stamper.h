@@ -86,6 +86,7 @@ class TriggerFrameStamper final : public SensorSink {
   void OnStereo(const StereoFrame& frame) override;
   void OnWheelOdometry(const WheelOdometrySample& sample) override { next_->OnWheelOdometry(sample); }
   void OnTrigger(const TriggerEvent& event) override;
+  void OnGnss(const GnssFix& fix) override { next_->OnGnss(fix); }
   void OnDeviceFault(const DeviceFault& fault) override { next_->OnDeviceFault(fault); }
 
   TriggerFrameStamperCounts counts() const;

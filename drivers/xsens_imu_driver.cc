@@ -1,13 +1,13 @@
 #include "drivers/xsens_imu_driver.h"
 
-#include <fcntl.h>
 #include <poll.h>
-#include <termios.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+
+#include "drivers/serial_port.h"
 
 namespace cairn {
 namespace {
@@ -19,22 +19,6 @@ constexpr uint8_t kError = 0x42;
 constexpr int kPollMs = 50;
 constexpr uint16_t kEveryPacket = 0xFFFF;  // output frequency of counters and status: with every packet
 
-speed_t Speed(int64_t baud) {
-  switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
-    case 2000000: return B2000000;
-    case 4000000: return B4000000;
-    default: return B0;
-  }
-}
-
 void PutBigEndian16(std::vector<uint8_t>* out, uint16_t v) {
   out->push_back(static_cast<uint8_t>(v >> 8));
   out->push_back(static_cast<uint8_t>(v & 0xFF));
@@ -43,7 +27,8 @@ void PutBigEndian16(std::vector<uint8_t>* out, uint16_t v) {
 }  // namespace
 
 Status XsensImuOptions::Validate() const {
-  if (Speed(baud) == B0) return InvalidArgumentError("baud " + std::to_string(baud) + " is not a standard serial rate");
+  if (!SerialPort::IsStandardBaud(baud))
+    return InvalidArgumentError("baud " + std::to_string(baud) + " is not a standard serial rate");
   if (device.empty()) return InvalidArgumentError("device must name the serial port");
   return Status::Ok();
 }
@@ -57,33 +42,6 @@ XsensImuDriver::~XsensImuDriver() { Stop(); }  // Stop() closes the device
 
 XsensImuCounts XsensImuDriver::counts() const {
   return {samples_.load(), corrupt_.load(), lost_.load(), reconnections_.load(), configurations_.load()};
-}
-
-Expected<int> XsensImuDriver::OpenPort(const std::string& device, int64_t baud) {
-  const speed_t speed = Speed(baud);
-  if (speed == B0) return InvalidArgumentError(device + ": baud " + std::to_string(baud) + " is not a standard rate");
-  const int fd = open(device.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return UnavailableError(device + ": " + std::strerror(errno));
-  termios t{};
-  if (tcgetattr(fd, &t) != 0) {
-    const int e = errno;
-    close(fd);
-    return UnavailableError(device + ": not a serial port (" + std::strerror(e) + ")");
-  }
-  cfmakeraw(&t);
-  t.c_cflag |= CLOCAL | CREAD;
-  t.c_cflag &= ~static_cast<tcflag_t>(CSTOPB | CRTSCTS);
-  t.c_cc[VMIN] = 0;
-  t.c_cc[VTIME] = 0;
-  cfsetispeed(&t, speed);
-  cfsetospeed(&t, speed);
-  if (tcsetattr(fd, TCSANOW, &t) != 0) {
-    const int e = errno;
-    close(fd);
-    return UnavailableError(device + ": cannot set 8N1 at " + std::to_string(baud) + " baud: " + std::strerror(e));
-  }
-  tcflush(fd, TCIOFLUSH);
-  return fd;
 }
 
 Status XsensImuDriver::Start(SensorSink* sink) {
@@ -254,7 +212,7 @@ void XsensImuDriver::Run(std::stop_token stop) {
         continue;
       }
       last_open = now;
-      auto fd = OpenPort(options_.device, options_.baud);
+      auto fd = SerialPort::Open(options_.device, options_.baud);
       if (!fd.ok()) {
         if (!reported_closed) Fault(DeviceFaultKind::kDisconnected, fd.status().message() + " (retrying)");
         reported_closed = true;

@@ -51,9 +51,6 @@ class XsensImuDriver final : public ImuInterface {
   // Read from the reader thread; a snapshot for reports.
   XsensImuCounts counts() const;
 
-  // Opens `device` raw 8N1 at `baud` (one of the standard rates), non-blocking.
-  static Expected<int> OpenPort(const std::string& device, int64_t baud);
-
  private:
   void Run(std::stop_token stop);
   // GoToConfig, SetOutputConfiguration, GoToMeasurement, each acknowledged in time.

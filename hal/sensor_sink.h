@@ -1,6 +1,7 @@
 #pragma once
 
 #include "hal/device_fault.h"
+#include "hal/gnss_fix.h"
 #include "hal/imu_sample.h"
 #include "hal/stereo_frame.h"
 #include "hal/trigger_event.h"
@@ -19,6 +20,7 @@ class SensorSink {
   virtual void OnStereo(const StereoFrame& frame) = 0;
   virtual void OnWheelOdometry(const WheelOdometrySample& sample) = 0;
   virtual void OnTrigger(const TriggerEvent& event) = 0;
+  virtual void OnGnss(const GnssFix& fix) = 0;
   virtual void OnDeviceFault(const DeviceFault& fault) = 0;
 };
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/options_visitor.h"
+#include "sim/gnss_simulator_options.h"
 
 namespace cairn {
 
@@ -18,6 +19,7 @@ struct SimSourceOptions {
   int64_t motion_blur_samples = 1;       // > 1 averages instants over the exposure
   int64_t render_threads = 2;            // 2: the right camera renders on a second thread
   bool deploy_from_lander = false;       // every robot starts in front of a lander tag
+  GnssSimulatorOptions gnss;             // this robot's GNSS receiver (off by default)
 
   void Visit(OptionsVisitor& v) {
     v.Text("world", world);
@@ -28,6 +30,7 @@ struct SimSourceOptions {
     v.Integer("motion_blur_samples", motion_blur_samples, 1, 64, "");
     v.Integer("render_threads", render_threads, 1, 2, "");
     v.Flag("deploy_from_lander", deploy_from_lander);
+    v.Section("gnss", gnss);
   }
 };
 

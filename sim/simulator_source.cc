@@ -25,8 +25,8 @@ Image ToImage(std::vector<uint8_t>&& pixels, int width, int height) {
 }  // namespace
 
 SimulatorSource::SimulatorSource(std::shared_ptr<const MissionSimulator> simulator, size_t robot,
-                                 ReplayOptions pacing)
-    : simulator_(std::move(simulator)), robot_(robot), clock_(pacing) {}
+                                 ReplayOptions pacing, const GnssSimulatorOptions& gnss, uint64_t seed)
+    : simulator_(std::move(simulator)), robot_(robot), gnss_(gnss), seed_(seed), clock_(pacing) {}
 
 SimulatorSource::~SimulatorSource() { Stop(); }
 
@@ -36,6 +36,11 @@ Status SimulatorSource::Start(SensorSink* sink) {
   sink_ = sink;
   imu_ = simulator_->ImuStream(robot_);
   if (simulator_->robots()[robot_].kind == SimRobotKind::kRover) can_ = simulator_->WheelStream(robot_);
+  if (gnss_.enabled) {
+    gnss_fixes_ =
+        GnssSimulator(gnss_, seed_, robot_)
+            .Generate(simulator_->robots()[robot_].trajectory, simulator_->start(), simulator_->duration());
+  }
   clock_.Start(simulator_->start());
   thread_ = std::jthread([this](std::stop_token stop) { Run(stop); });
   return Status::Ok();
@@ -49,7 +54,7 @@ void SimulatorSource::Stop() {
 }
 
 size_t SimulatorSource::memory_bytes() const {
-  return HeapBytes(imu_, can_.frames, can_.reported);
+  return HeapBytes(imu_, can_.frames, can_.reported, gnss_fixes_);
 }
 
 void SimulatorSource::Run(std::stop_token stop) {
@@ -58,16 +63,21 @@ void SimulatorSource::Run(std::stop_token stop) {
   const double duration = simulator_->duration();
   const std::vector<ImuTruth>& imu = imu_;
   const WheelCanStream& can = can_;
+  const std::vector<GnssTruth>& gnss = gnss_fixes_;
   CanWheelDecoder decoder(simulator_->can_layout());
   const int64_t period_ns = std::llround(1e9 / robot.camera_rate_hz);
   const size_t frames = static_cast<size_t>(std::floor(duration * robot.camera_rate_hz + 1e-9)) + 1;
-  size_t i = 0, c = 0, f = 0;
+  size_t i = 0, c = 0, f = 0, g = 0;
   bool stopped = false;
-  while (i < imu.size() || c < can.frames.size() || f < frames) {
+  while (i < imu.size() || c < can.frames.size() || f < frames || g < gnss.size()) {
     const Timestamp ti = i < imu.size() ? imu[i].sample.time : Timestamp::Max();
     const Timestamp tc = c < can.frames.size() ? can.frames[c].time : Timestamp::Max();
     const Timestamp tf = f < frames ? start + Duration::Nanoseconds(static_cast<int64_t>(f) * period_ns) : Timestamp::Max();
-    if (ti <= tc && ti <= tf) {
+    const Timestamp tg = g < gnss.size() ? gnss[g].published : Timestamp::Max();
+    if (tg < ti && tg < tc && tg < tf) {
+      if ((stopped = !clock_.WaitUntilDue(stop, tg))) break;
+      sink_->OnGnss(gnss[g++].fix);
+    } else if (ti <= tc && ti <= tf) {
       if ((stopped = !clock_.WaitUntilDue(stop, ti))) break;
       sink_->OnImu(imu[i++].sample);
     } else if (tc <= tf) {

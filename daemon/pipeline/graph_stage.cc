@@ -47,7 +47,8 @@ GraphStage::GraphStage(const GraphStageOptions& options, bool deterministic)
         return o;
       }()),
       graph_(options_.optimizer),
-      robot_(options_.optimizer.own_robot) {}
+      robot_(options_.optimizer.own_robot),
+      gnss_(options_.gnss) {}
 
 uint64_t GraphStage::OriginKey(uint64_t frame_id) const {
   return VariableKey(VariableKind::kSubmap, robot_, frame_id);
@@ -117,6 +118,7 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
   }
   estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
   if (!pending_detections_.empty()) RetryPendingDetections();
+  if (!pending_fixes_.empty()) RetryPendingFixes();
   if ((estimates_.size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
   pose_covariances_[RunKey{robot_, kCurrentRun}].push_back(PoseCovariance{e.time, e.frame_id, e.pose_covariance});
   SlamFactor v;
@@ -507,11 +509,60 @@ void GraphStage::RetryPendingDetections() {
   report_.detections_pending = pending_detections_.size();
 }
 
+void GraphStage::AddGnssFix(const GnssFix& fix) {
+  ++report_.gnss_fixes;
+  if (const Status s = gnss_.Check(fix); !s.ok()) {
+    ++report_.gnss_refused;
+    Error(s.ToString());
+    return;
+  }
+  pending_fixes_.push_back(fix);
+  RetryPendingFixes();
+}
+
+void GraphStage::RetryPendingFixes() {
+  // Fixes come in time order: the first that waits holds the later ones.
+  size_t taken = 0;
+  for (; taken < pending_fixes_.size(); ++taken) {
+    const GnssFix& fix = pending_fixes_[taken];
+    Placed pose;
+    Matrix6d covariance;
+    std::string why;
+    const PoseLookup lookup = PoseAt(robot_, kCurrentRun, fix.time, &pose, &covariance, &why);
+    if (lookup == PoseLookup::kWait || !graph_.HasVariable(OriginKey(pose.frame_id))) break;
+    if (lookup == PoseLookup::kNever) {
+      ++report_.gnss_unplaced;
+      continue;
+    }
+    const uint64_t key = DetectionPose(robot_, kCurrentRun, fix.time, pose, covariance);
+    const auto T_world_body = graph_.Pose(key);
+    if (!T_world_body.ok()) {
+      ++report_.gnss_unplaced;
+      continue;
+    }
+    bool added = false;
+    for (const SlamFactor& f : gnss_.Add(fix, key, *T_world_body)) added = Add(f) || added;
+    if (added) Update();
+  }
+  pending_fixes_.erase(pending_fixes_.begin(), pending_fixes_.begin() + static_cast<long>(taken));
+  report_.gnss_factors = gnss_.counts().factors;
+  report_.gnss_pending = pending_fixes_.size() + gnss_.counts().held;
+  report_.gnss_datum = gnss_.counts().datum_started;
+}
+
+bool GraphStage::Datum(Eigen::Isometry3d* T_world_enu) const {
+  if (!gnss_.counts().datum_started) return false;
+  const auto pose = graph_.Pose(GnssFixFactors::DatumKey());
+  if (!pose.ok()) return false;
+  *T_world_enu = ToIsometry(*pose);
+  return true;
+}
+
 std::vector<char> GraphStage::Robots() const {
   std::vector<char> out{robot_};
   std::set<char> seen{robot_};
   for (uint64_t key : graph_.VariableKeys()) {
-    if (KindOfKey(key) == VariableKind::kLandmark) continue;
+    if (KindOfKey(key) == VariableKind::kLandmark || KindOfKey(key) == VariableKind::kDatum) continue;
     if (seen.insert(RobotOfVariable(key)).second) out.push_back(RobotOfVariable(key));
   }
   return out;
@@ -637,6 +688,7 @@ GraphScene GraphStage::Scene(bool covariances) {
   };
   for (uint64_t key : graph_.VariableKeys()) {
     if (loose.count(key) != 0) continue;  // where the graph cannot place it yet: not drawn
+    if (KindOfKey(key) == VariableKind::kDatum) continue;
     auto p = graph_.Pose(key);
     if (!p.ok()) continue;
     GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero(), ""};
@@ -662,7 +714,7 @@ GraphScene GraphStage::Scene(bool covariances) {
     if (const auto c = origin_covariance_.find(n.key); c != origin_covariance_.end()) n.position_covariance = c->second;
   }
   for (const SlamFactor& f : graph_.factors()) {
-    if (!IsUnary(f.kind)) scene.edges.push_back(GraphScene::Edge{f.a, f.b, f.kind});
+    if (IsPoseEdge(f.kind)) scene.edges.push_back(GraphScene::Edge{f.a, f.b, f.kind});
   }
   constexpr size_t kMaxTrackPoints = 400;
   for (char r : Robots()) {
@@ -683,12 +735,14 @@ GraphScene GraphStage::Scene(bool covariances) {
 PoseGraph GraphStage::ExportPoseGraph() const {
   PoseGraph g;
   for (uint64_t key : graph_.VariableKeys()) {
+    // The datum has no pose edges (its GNSS factors are not g2o's).
+    if (KindOfKey(key) == VariableKind::kDatum) continue;
     if (auto p = graph_.Pose(key); p.ok()) g.SetVertex(key, *p);
   }
   g.set_has_initial_estimate(true);
   for (const SlamFactor& f : graph_.factors()) {
     // Not the prior: g2o readers take the first vertex as the gauge.
-    if (!IsUnary(f.kind)) g.AddEdge(EdgeOfFactor(f));
+    if (IsPoseEdge(f.kind)) g.AddEdge(EdgeOfFactor(f));
   }
   return g;
 }

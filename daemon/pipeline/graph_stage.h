@@ -53,6 +53,12 @@ struct GraphStageReport {
   // Trajectories and pose covariances kept for placing sightings and writing the global
   // trajectory, and the sightings' records: they grow with the mission, like the map.
   uint64_t history_bytes = 0;
+  uint64_t gnss_fixes = 0;       // fixes given
+  uint64_t gnss_factors = 0;     // fixes that entered the graph
+  uint64_t gnss_refused = 0;     // no solution, not finite, too inaccurate
+  uint64_t gnss_unplaced = 0;    // no estimate of the robot at their time
+  uint64_t gnss_pending = 0;     // waiting for estimates, or for the datum to start
+  bool gnss_datum = false;       // the datum is estimated (fixes spread far enough)
   double chi2 = 0.0;             // after the final solve
   double final_cost = 0.0;
   std::vector<std::string> errors;  // the first few, verbatim
@@ -96,6 +102,12 @@ class GraphStage {
   // the covariance of its nearest graph pose; it waits until both robots' estimates cover the
   // time. Landmark `observed` names are those of SetLandmarks().
   void AddDetection(const TeamDetection& detection, bool usable, const std::string& refused);
+  // A GNSS fix of this robot's antenna: once the filter's estimates cover its time it becomes a graph
+  // pose x there (as for a detection) and, after the datum has started, a factor from the datum
+  // (gnss_fix_factors.h). Refused fixes are counted with the first reasons in the report's errors.
+  void AddGnssFix(const GnssFix& fix);
+  // T_world_enu of the GNSS datum; false before fixes have started it.
+  bool Datum(Eigen::Isometry3d* T_world_enu) const;
   // Landmark carriers by name: the index of each is its variable's.
   void SetLandmarks(const std::vector<std::string>& names) { landmarks_ = names; }
   const std::vector<DetectionRecord>& detections() const { return detection_records_; }
@@ -202,6 +214,9 @@ class GraphStage {
   // Adds the pose variable of `robot` at `time` (once) with its factor v; returns its key.
   uint64_t DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose, const Matrix6d& covariance);
   void RetryPendingDetections();
+  void RetryPendingFixes();
+  GnssFixFactors gnss_;
+  std::vector<GnssFix> pending_fixes_;
   // Whether a sighting of a robot agrees with both robots' gravity (their estimates' roll and
   // pitch); if only IPPE's other minimum does, `T_observer_observed` becomes it and `chosen` says so.
   bool AgreesWithGravity(const TeamDetection& d, const Placed& observer, const Placed& observed,

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "common/options_visitor.h"
+#include "daemon/pipeline/gnss_fix_factors.h"
 #include "estimation/graph/slam_graph.h"
 
 namespace cairn {
@@ -22,6 +23,7 @@ struct GraphStageOptions {
   double min_rotation_sigma = 0.001;  // rad
   bool write_g2o = true;              // OUT/graph.g2o at the end
   SlamGraphOptions optimizer;
+  GnssFixOptions gnss;  // fixes as factors on the team's datum (off by default)
 
   void Visit(OptionsVisitor& v) {
     v.Flag("enabled", enabled);
@@ -30,6 +32,7 @@ struct GraphStageOptions {
     v.Number("min_rotation_sigma", min_rotation_sigma, 1e-6, 1.0, "rad");
     v.Flag("write_g2o", write_g2o);
     v.Section("optimizer", optimizer);
+    v.Section("gnss", gnss);
   }
 };
 

@@ -7,6 +7,7 @@
 
 #include "daemon/telemetry/graph_scene_encoder.h"
 #include "estimation/graph/g2o_io.h"
+#include "estimation/math/local_tangent_plane.h"
 #include "foxglove/SceneUpdate.pb.h"
 
 namespace cairn {
@@ -600,6 +601,75 @@ TEST(GraphStageTest, ThisRobotsEarlierRunJoinsItsGraphAsARunOfItsOwn) {
   const Trajectory t = g.GlobalTrajectory('a', earlier);
   ASSERT_EQ(t.poses.size(), 100u);
   EXPECT_LT((t.poses[80].T_frame_body.translation() - (Offset() * a.T_world_body[80]).translation()).norm(), 0.05);
+}
+
+TEST(GraphStageTest, GnssFixesStartTheDatumAndAreCountedWhenRefusedOrUnplaced) {
+  const Drive d = MakeDrive(120, 25);
+  GraphStageOptions o = Options();
+  o.gnss.enabled = true;
+  o.gnss.datum_latitude = 46.5;
+  o.gnss.datum_longitude = 7.9;
+  o.gnss.antenna_z = 0.5;
+  GraphStage g(o, /*deterministic=*/true);
+  const LocalTangentPlane plane(
+      GeodeticPoint{46.5 * std::numbers::pi / 180, 7.9 * std::numbers::pi / 180, 0.0});
+  Eigen::Isometry3d T_world_enu = Eigen::Isometry3d::Identity();
+  T_world_enu.linear() = Eigen::AngleAxisd(-0.8, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_world_enu.translation() = Eigen::Vector3d(40.0, -25.0, 3.0);
+  auto fix_at = [&](int i) {
+    const Eigen::Vector3d enu =
+        T_world_enu.inverse() * (d.T_world_body[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, 0.5));
+    const GeodeticPoint p = plane.ToGeodetic(enu);
+    GnssFix fix;
+    fix.time = Timestamp::FromNanoseconds(int64_t{100000000} * i);
+    fix.latitude = p.latitude;
+    fix.longitude = p.longitude;
+    fix.height = p.height;
+    fix.covariance = Eigen::Matrix3d::Identity() * 0.01;
+    fix.quality = GnssQuality::kDifferential;
+    return fix;
+  };
+  GnssFix early = fix_at(0);
+  early.time = early.time - Duration::Seconds(1.0);  // before the filter's first estimate
+  GnssFix lost = fix_at(3);
+  lost.quality = GnssQuality::kNone;
+  size_t estimates = 0, fixes = 0;
+  for (const GraphInput& in : d.inputs) {
+    g.OnInput(in);
+    if (in.kind != GraphInput::Kind::kEstimate) continue;
+    if (estimates == 1) {
+      g.AddGnssFix(early);
+      g.AddGnssFix(lost);
+    }
+    // At 1 Hz, arriving a little after their time, as a receiver's do.
+    if (estimates >= 3 && (estimates - 3) % 10 == 0) {
+      g.AddGnssFix(fix_at(static_cast<int>(estimates) - 3));
+      ++fixes;
+    }
+    ++estimates;
+  }
+  g.Finish();
+  const GraphStageReport r = g.report();
+  EXPECT_EQ(r.gnss_fixes, fixes + 2);
+  EXPECT_EQ(r.gnss_refused, 1u);
+  EXPECT_EQ(r.gnss_unplaced, 1u);
+  EXPECT_TRUE(r.gnss_datum);
+  EXPECT_EQ(r.gnss_factors + r.gnss_pending, fixes);
+  EXPECT_GE(r.gnss_factors, fixes - 1);  // the last may wait for a later estimate
+  Eigen::Isometry3d datum;
+  ASSERT_TRUE(g.Datum(&datum));
+  EXPECT_LT(Eigen::AngleAxisd(datum.linear().transpose() * T_world_enu.linear()).angle(), 0.01);
+  EXPECT_LT((datum.translation() - T_world_enu.translation()).norm(), 0.05);
+  // The fixes agree with the filter: the trajectory stays where it was.
+  const Trajectory t = g.GlobalTrajectory();
+  ASSERT_EQ(t.poses.size(), d.T_world_body.size());
+  for (size_t i = 0; i < t.poses.size(); i += 20) {
+    EXPECT_LT((t.poses[i].T_frame_body.translation() - d.T_world_body[i].translation()).norm(), 0.02) << i;
+  }
+  // The datum is not a robot and not a pose of the g2o graph.
+  EXPECT_EQ(g.Robots(), std::vector<char>{'a'});
+  const PoseGraph exported = g.ExportPoseGraph();
+  for (uint64_t id : exported.ids()) EXPECT_NE(KindOfKey(id), VariableKind::kDatum);
 }
 
 }  // namespace

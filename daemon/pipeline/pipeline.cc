@@ -16,8 +16,8 @@ int64_t MonotonicNs() { return MonotonicClock().Now().nanoseconds(); }
 
 }  // namespace
 
-Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues,
-                   PipelineRates rates, bool deterministic)
+Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues, PipelineRates rates,
+                   bool deterministic)
     : deterministic_(deterministic),
       imu_queue_(static_cast<size_t>(queues.imu)),
       wheel_queue_(static_cast<size_t>(queues.wheel_odometry)),
@@ -28,7 +28,8 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       vo_result_queue_(32),
       switch_queue_(8),
       estimate_queue_(256),
-      estimation_inputs_(imu_queue_, wheel_queue_, trigger_queue_, clone_queue_, vo_result_queue_, switch_queue_),
+      estimation_inputs_(imu_queue_, wheel_queue_, trigger_queue_, clone_queue_, vo_result_queue_,
+                         switch_queue_),
       dense_queue_(static_cast<size_t>(queues.dense)),
       mapping_estimate_queue_(256),
       switch_event_queue_(16),
@@ -36,6 +37,7 @@ Pipeline::Pipeline(const ExecutorsOptions& executors, const QueueOptions& queues
       submap_queue_(static_cast<size_t>(queues.submaps)),
       detection_queue_(static_cast<size_t>(queues.detection)),
       sighting_queue_(static_cast<size_t>(queues.sightings)),
+      gnss_queue_(256),
       imu_deadline_(rates.imu_hz > 0.0 ? Duration::Seconds(1.0 / rates.imu_hz) : Duration::Seconds(0.01)),
       estimation_exec_("estimation", executors.estimation),
       stereo_("stereo", executors.stereo),
@@ -93,6 +95,7 @@ Status Pipeline::EnableGraph(const GraphStageOptions& options) {
   // Live, full solves after loop closures run on their own executor; replays solve them inline so
   // that the result does not depend on thread timing.
   if (!deterministic_) graph_->SetBackgroundRunner(graph_worker_.Runner());
+  gnss_enabled_ = options.gnss.enabled;
   estimation_->PublishToGraph(&graph_queue_);
   return Status::Ok();
 }
@@ -222,6 +225,7 @@ void Pipeline::StopAndDrain() {
     graph_signal_.Notify();
     graph_exec_.Join();
     if (detection_) TakeSightings(Timestamp::FromNanoseconds(INT64_MAX));
+    if (gnss_enabled_) TakeGnssFixes(Timestamp::Max());
     if (team_) {
       // The last own items go out; teammates' keep coming until the team holds the same logs
       // (or the linger time is over). This thread owns the graph now.
@@ -294,10 +298,26 @@ void Pipeline::Publish(SpscQueue<Queued<T>>& queue, const T& value, WorkSignal& 
   }
 }
 
-void Pipeline::OnImu(const ImuSample& s) { Publish(imu_queue_, s, estimation_signal_); }
+void Pipeline::OnImu(const ImuSample& s) {
+  if (gnss_enabled_) last_imu_ns_.store(s.time.nanoseconds(), std::memory_order_relaxed);
+  Publish(imu_queue_, s, estimation_signal_);
+}
 void Pipeline::OnWheelOdometry(const WheelOdometrySample& s) { Publish(wheel_queue_, s, estimation_signal_); }
 void Pipeline::OnTrigger(const TriggerEvent& e) { Publish(trigger_queue_, e, estimation_signal_); }
 void Pipeline::OnStereo(const StereoFrame& f) { Publish(stereo_queue_, f, stereo_signal_); }
+void Pipeline::OnGnss(const GnssFix& fix) {
+  if (!gnss_enabled_) return;
+  const QueuedFix item{
+      fix, std::max(fix.time, Timestamp::FromNanoseconds(last_imu_ns_.load(std::memory_order_relaxed)))};
+  // Never held until consumed, even in deterministic runs: the graph takes a fix at the first
+  // estimate after `after`, and that estimate needs the samples this publisher sends next.
+  if (deterministic_) {
+    while (!gnss_queue_.TryPush(item)) std::this_thread::yield();
+  } else if (!gnss_queue_.TryPush(item)) {
+    return;  // a full queue counts the drop
+  }
+  graph_signal_.Notify();
+}
 
 void Pipeline::OnDeviceFault(const DeviceFault& fault) {
   // Faults are rare and come from driver threads: a lock here never touches a real-time path.
@@ -611,6 +631,14 @@ void Pipeline::TakeSightings(Timestamp before) {
   }
 }
 
+void Pipeline::TakeGnssFixes(Timestamp before) {
+  while (const QueuedFix* queued = gnss_queue_.Front()) {
+    if (!(queued->after < before)) return;
+    graph_->AddGnssFix(queued->fix);
+    gnss_queue_.PopFront();
+  }
+}
+
 void Pipeline::MappingLoop(std::stop_token stop) {
   std::stop_callback wake(stop, [this] { mapping_signal_.Notify(); });
   while (true) {
@@ -652,6 +680,8 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       // Deterministic: the sightings of the images before this estimate are in (the publisher is
       // held until each image's detection is done), a fixed point of the data flow.
       if (detection_ && in->kind == GraphInput::Kind::kEstimate) TakeSightings(in->estimate.time);
+      // Likewise the fixes: each was published before the IMU samples of any estimate after its `after`.
+      if (gnss_enabled_ && in->kind == GraphInput::Kind::kEstimate) TakeGnssFixes(in->estimate.time);
       graph_->OnInput(*in);
       if (team_) PublishToTeam(*in);
       // Submap k is finished before mapping asks to leave frame k + 1, so once the switch into
@@ -666,6 +696,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       }
     }
     if (detection_ && !deterministic_) TakeSightings(Timestamp::FromNanoseconds(INT64_MAX));
+    if (gnss_enabled_ && (!deterministic_ || stop.stop_requested())) TakeGnssFixes(Timestamp::Max());
     if (worked && predict_carriers_) PublishPredictions();
     if (matching_ && !deterministic_) {
       TakeSubmaps(UINT64_MAX);
@@ -710,6 +741,7 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
     }
   }
   if (graph_) out.push_back(r("graph", graph_queue_));
+  if (gnss_enabled_) out.push_back(r("gnss", gnss_queue_));
   if (matching_) out.push_back(r("submaps", submap_queue_));
   if (detection_) {
     out.push_back(r("detection", detection_queue_));
@@ -720,10 +752,11 @@ std::vector<QueueReport> Pipeline::queue_reports() const {
 
 uint64_t Pipeline::total_dropped() const {
   return imu_queue_.dropped() + wheel_queue_.dropped() + trigger_queue_.dropped() + stereo_queue_.dropped() +
-         rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() + switch_queue_.dropped() +
-         estimate_queue_.dropped() + dense_queue_.dropped() + mapping_estimate_queue_.dropped() +
-         switch_event_queue_.dropped() + graph_queue_.dropped() + submap_queue_.dropped() + detection_queue_.dropped() +
-         sighting_queue_.dropped();
+         rectified_queue_.dropped() + clone_queue_.dropped() + vo_result_queue_.dropped() +
+         switch_queue_.dropped() + estimate_queue_.dropped() + dense_queue_.dropped() +
+         mapping_estimate_queue_.dropped() + switch_event_queue_.dropped() + graph_queue_.dropped() +
+         submap_queue_.dropped() + detection_queue_.dropped() + sighting_queue_.dropped() +
+         gnss_queue_.dropped();
 }
 
 std::vector<LatencyReport> Pipeline::latency_reports() const {

@@ -141,6 +141,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void OnStereo(const StereoFrame& frame) override;
   void OnWheelOdometry(const WheelOdometrySample& sample) override;
   void OnTrigger(const TriggerEvent& event) override;
+  void OnGnss(const GnssFix& fix) override;
   void OnDeviceFault(const DeviceFault& fault) override;
 
   // Valid after StopAndDrain().
@@ -195,6 +196,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void DetectionLoop(std::stop_token stop);
   // Graph thread: this robot's sightings up to (not including) `before` into the graph and the team.
   void TakeSightings(Timestamp before);
+  // Gives the graph the GNSS fixes measured before `before`.
+  void TakeGnssFixes(Timestamp before);
   // Graph thread: where the graph places this robot and the carriers, for the detection thread.
   void PublishPredictions();
   void GraphLoop(std::stop_token stop);
@@ -240,6 +243,15 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   WorkSignal detection_signal_;
   SpscQueue<Queued<RectifiedPair>> detection_queue_;
   SpscQueue<TagSighting> sighting_queue_;
+  // GNSS: the receiver's (or simulator's) thread -> graph thread. `after`: the latest IMU time
+  // published before the fix, so that a deterministic run takes each fix at the same estimate.
+  struct QueuedFix {
+    GnssFix fix;
+    Timestamp after;
+  };
+  SpscQueue<QueuedFix> gnss_queue_;
+  bool gnss_enabled_ = false;
+  std::atomic<int64_t> last_imu_ns_{INT64_MIN};
   const Duration imu_deadline_;
   std::atomic<uint64_t> deadline_misses_{0};
 

@@ -52,7 +52,7 @@ Status InitializeSnapshotChordal(GraphSnapshot& s) {
     if (!g.HasVertex(s.keys[i])) g.SetVertex(s.keys[i], s.poses[i]);
   }
   for (const auto& f : s.factors) {
-    if (!IsUnary(f.kind)) g.AddEdge(EdgeOfFactor(f));
+    if (IsPoseEdge(f.kind)) g.AddEdge(EdgeOfFactor(f));
   }
   CAIRN_RETURN_IF_ERROR(InitializeChordal(g));
   for (size_t i = 0; i < g.num_vertices(); ++i) s.poses[index(g.ids()[i])] = g.poses()[i];

@@ -17,4 +17,15 @@ ceres::CostFunction* AbsolutePositionResidual::Create(const Eigen::Vector3d& z, 
   return new ceres::AutoDiffCostFunction<AbsolutePositionResidual, 3, 7>(new AbsolutePositionResidual(z, information));
 }
 
+GnssPositionResidual::GnssPositionResidual(const Eigen::Vector3d& z_enu, const Eigen::Matrix3d& information,
+                                           const Eigen::Vector3d& antenna)
+    : z_(z_enu), sqrt_info(information.llt().matrixU()), antenna_(antenna) {}
+
+ceres::CostFunction* GnssPositionResidual::Create(const Eigen::Vector3d& z_enu,
+                                                  const Eigen::Matrix3d& information,
+                                                  const Eigen::Vector3d& antenna) {
+  return new ceres::AutoDiffCostFunction<GnssPositionResidual, 3, 7, 7>(
+      new GnssPositionResidual(z_enu, information, antenna));
+}
+
 }  // namespace cairn

@@ -1,8 +1,8 @@
 #pragma once
 // Ceres cost functors on 6-D poses (the reference residuals; Create() gives the analytic cost
-// functions of pose_cost_functions.h, which tests check against AutoDiff() of these). A pose parameter block is 7 doubles [tx ty tz qx qy qz qw]
-// on PoseManifold() (R^3 x unit quaternion; the quaternion increment is applied on the left, so
-// covariances are in the world frame for rotation). Residual conventions:
+// functions of pose_cost_functions.h, which tests check against AutoDiff() of these). A pose parameter block
+// is 7 doubles [tx ty tz qx qy qz qw] on PoseManifold() (R^3 x unit quaternion; the quaternion increment is
+// applied on the left, so covariances are in the world frame for rotation). Residual conventions:
 //  - Relative pose (geodesic): E = T_ij^-1 T_i^-1 T_j, r = sqrt(Info) [t(E); Log(R(E))]. Used for
 //    every binary factor of the thesis (w, v, d, o, c, u) and EDGE_SE3 in the default objective.
 //  - Chordal (SE-Sync): r = [sqrt(tau)(R_i^T (t_j - t_i) - t_ij); sqrt(8 kappa) vec(q_ij^-1 q_i^-1 q_j)]
@@ -12,7 +12,9 @@
 //    of the same sum: their Gauss-Newton model is poor away from the optimum's small residuals
 //    (sphere2500: 13 iterations converging linearly instead of 2).
 //  - Absolute pose: E = Z^-1 T, r = sqrt(Info) [t(E); Log(R(E))] (prior, GNSS pose, known landmark).
-//  - Absolute position: r = sqrt(Info) (t - z) (GNSS / total-station position fix).
+//  - Absolute position: r = sqrt(Info) (t - z) (total-station position fix).
+//  - GNSS position, on the datum E = T_world_enu and the pose x: r = sqrt(Info) (R_E^T (t_x + R_x l -
+//    t_E) - z) for the antenna at l in the body; z in the datum's east-north-up axes.
 
 #include <memory>
 
@@ -145,6 +147,28 @@ struct AbsolutePositionResidual {
 
   Eigen::Vector3d z_;
   Eigen::Matrix3d sqrt_info;
+};
+
+struct GnssPositionResidual {
+  GnssPositionResidual(const Eigen::Vector3d& z_enu, const Eigen::Matrix3d& information,
+                       const Eigen::Vector3d& antenna);
+
+  template <class T>
+  bool operator()(const T* datum, const T* pose, T* out) const {
+    using namespace pose_factors_internal;
+    using V3 = Eigen::Matrix<T, 3, 1>;
+    const V3 antenna_world = V3(pose[0], pose[1], pose[2]) + Q(pose) * antenna_.cast<T>();
+    const V3 enu = Q(datum).conjugate() * (antenna_world - V3(datum[0], datum[1], datum[2]));
+    Eigen::Map<Eigen::Matrix<T, 3, 1>>{out} = sqrt_info.cast<T>() * (enu - z_.cast<T>());
+    return true;
+  }
+
+  static ceres::CostFunction* Create(const Eigen::Vector3d& z_enu, const Eigen::Matrix3d& information,
+                                     const Eigen::Vector3d& antenna);
+
+  Eigen::Vector3d z_;
+  Eigen::Matrix3d sqrt_info;
+  Eigen::Vector3d antenna_;
 };
 
 // Pose <-> parameter block.

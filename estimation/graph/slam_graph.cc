@@ -18,7 +18,7 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
   using K = VariableKind;
   const K ka = KindOfKey(f.a), kb = KindOfKey(f.b);
   const bool same_robot = RobotOfVariable(f.a) == RobotOfVariable(f.b);
-  auto is = [](K k) { return k == K::kRobotPose || k == K::kSubmap || k == K::kLandmark; };
+  auto is = [](K k) { return k == K::kRobotPose || k == K::kSubmap || k == K::kLandmark || k == K::kDatum; };
   if (!is(ka) || (!IsUnary(f.kind) && !is(kb))) return InvalidArgumentError("factor on a malformed variable key");
   if (!IsUnary(f.kind) && f.a == f.b) return InvalidArgumentError("binary factor on one variable");
   bool ok = true;
@@ -34,9 +34,13 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
       break;
     case FactorKind::kAbsolutePose:
     case FactorKind::kAbsolutePosition: ok = true; break;
+    case FactorKind::kGnssPosition:
+      ok = ka == K::kDatum && kb == K::kRobotPose;
+      break;
   }
   if (!ok) return InvalidArgumentError("factor kind does not fit its variables");
-  if (f.kind == FactorKind::kAbsolutePosition) {
+  if (IsPositionFactor(f.kind)) {
+    if (!f.position.allFinite() || !f.antenna.allFinite()) return InvalidArgumentError("non-finite position");
     if (f.position_information.llt().info() != Eigen::Success) {
       return InvalidArgumentError("position information is not positive definite");
     }
@@ -73,6 +77,14 @@ SlamGraph::~SlamGraph() = default;
 
 Status SlamGraph::AddFactor(const SlamFactor& f) {
   CAIRN_RETURN_IF_ERROR(CheckKinds(f, options_.own_robot));
+  if (f.kind == FactorKind::kGnssPosition) {
+    // A position alone cannot place a pose or a datum, nor join a floating component rigidly.
+    if (!HasVariable(f.a) || !HasVariable(f.b))
+      return InvalidArgumentError("GNSS fix on an unknown datum or pose");
+    if (variables_.at(f.a).component != variables_.at(f.b).component) {
+      return InvalidArgumentError("GNSS fix on a pose not tied to the datum");
+    }
+  }
   ++num_added_factors_;
   if (f.kind == FactorKind::kAbsolutePosition && !HasVariable(f.a)) {
     pending_.push_back(f);  // no orientation to start it from: wait for the variable
@@ -476,6 +488,12 @@ double SlamGraph::Chi2() const {
     const Pose3 a = *Pose(f.a);
     if (f.kind == FactorKind::kAbsolutePosition) {
       const Eigen::Vector3d e = a.t - f.position;
+      chi2 += e.dot(f.position_information * e);
+      continue;
+    }
+    if (f.kind == FactorKind::kGnssPosition) {
+      const Pose3 x = *Pose(f.b);
+      const Eigen::Vector3d e = a.R().transpose() * (x.t + x.R() * f.antenna - a.t) - f.position;
       chi2 += e.dot(f.position_information * e);
       continue;
     }

@@ -9,9 +9,16 @@ bool IsUnary(FactorKind kind) {
          kind == FactorKind::kAbsolutePosition;
 }
 
+bool IsPoseEdge(FactorKind kind) { return !IsUnary(kind) && kind != FactorKind::kGnssPosition; }
+
+bool IsPositionFactor(FactorKind kind) {
+  return kind == FactorKind::kAbsolutePosition || kind == FactorKind::kGnssPosition;
+}
+
 bool IsRobustFactor(FactorKind kind) {
   return kind == FactorKind::kDetection || kind == FactorKind::kLandmark || kind == FactorKind::kMatch ||
-         kind == FactorKind::kAbsolutePose || kind == FactorKind::kAbsolutePosition;
+         kind == FactorKind::kAbsolutePose || kind == FactorKind::kAbsolutePosition ||
+         kind == FactorKind::kGnssPosition;
 }
 
 PoseGraphEdge EdgeOfFactor(const SlamFactor& f) {
@@ -29,6 +36,8 @@ ceres::CostFunction* MakeFactorCostFunction(const SlamFactor& f) {
     case FactorKind::kPrior:
     case FactorKind::kAbsolutePose: return AbsolutePoseResidual::Create(f.z, f.information);
     case FactorKind::kAbsolutePosition: return AbsolutePositionResidual::Create(f.position, f.position_information);
+    case FactorKind::kGnssPosition:
+      return GnssPositionResidual::Create(f.position, f.position_information, f.antenna);
     default: return RelativePoseResidual::Create(f.z, f.information);
   }
 }

@@ -12,7 +12,8 @@ class CostFunction;
 
 namespace cairn {
 
-enum class VariableKind : uint8_t { kRobotPose = 'x', kSubmap = 's', kLandmark = 'l' };
+// kDatum: T_world_enu, the local east-north-up frame of the team's GNSS datum in the graph's world.
+enum class VariableKind : uint8_t { kRobotPose = 'x', kSubmap = 's', kLandmark = 'l', kDatum = 'e' };
 
 // Variable key: robot letter in the top byte (as the g2o multi-robot keys), kind in the next.
 constexpr uint64_t VariableKey(VariableKind kind, char robot, uint64_t index) {
@@ -32,7 +33,8 @@ enum class FactorKind {
   kLandmark,          // o: x -> l
   kMatch,             // c: s -> s
   kAbsolutePose,      // unary pose fix (known landmark, GNSS with heading)
-  kAbsolutePosition,  // unary position fix (GNSS)
+  kAbsolutePosition,  // unary position fix in the world frame (total station)
+  kGnssPosition,      // e -> x: the antenna's position in the datum's east-north-up frame
 };
 
 struct SlamFactor {
@@ -43,16 +45,22 @@ struct SlamFactor {
   Matrix6d information = Matrix6d::Identity();  // tx ty tz, rotation vector
   Eigen::Vector3d position = Eigen::Vector3d::Zero();               // kAbsolutePosition
   Eigen::Matrix3d position_information = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d antenna = Eigen::Vector3d::Zero();  // kGnssPosition: in b's body frame
 };
 
 bool IsUnary(FactorKind kind);
+// Binary factors that measure a relative pose (every one but the GNSS fixes): the edges of the
+// pose graph, its chordal initialization and its g2o export.
+bool IsPoseEdge(FactorKind kind);
+// Factors whose measurement is a position (3 residuals) rather than a pose.
+bool IsPositionFactor(FactorKind kind);
 // Factors that get the Cauchy loss (thesis 4.2.3: detections, landmarks, matches; also fixes).
 bool IsRobustFactor(FactorKind kind);
 
-// The g2o / PoseGraph edge of binary factor `f` (with its isotropic SE-Sync weights).
+// The g2o / PoseGraph edge of pose-edge factor `f` (with its isotropic SE-Sync weights).
 PoseGraphEdge EdgeOfFactor(const SlamFactor& f);
 
-// The residual of `f` (geodesic relative / absolute pose, or absolute position); caller owns it.
+// The residual of `f` (geodesic relative / absolute pose, absolute or GNSS position); caller owns it.
 ceres::CostFunction* MakeFactorCostFunction(const SlamFactor& f);
 
 }  // namespace cairn

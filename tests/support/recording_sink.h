@@ -17,6 +17,9 @@ class RecordingSink final : public SensorSink {
   void OnStereo(const StereoFrame& f) override { Add([&] { stereo.push_back(f); }); }
   void OnWheelOdometry(const WheelOdometrySample& s) override { Add([&] { wheel.push_back(s); }); }
   void OnTrigger(const TriggerEvent& e) override { Add([&] { triggers.push_back(e); }); }
+  void OnGnss(const GnssFix& g) override {
+    Add([&] { gnss.push_back(g); });
+  }
   void OnDeviceFault(const DeviceFault& f) override { Add([&] { faults.push_back(f); }); }
 
   // Waits (up to `timeout`) until `done()` holds, evaluated under the lock.
@@ -31,6 +34,7 @@ class RecordingSink final : public SensorSink {
   std::vector<StereoFrame> stereo;
   std::vector<WheelOdometrySample> wheel;
   std::vector<TriggerEvent> triggers;
+  std::vector<GnssFix> gnss;
   std::vector<DeviceFault> faults;
 
  private:
