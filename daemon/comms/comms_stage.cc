@@ -187,6 +187,13 @@ void CommsStage::PublishDetection(const TeamDetection& detection) {
   Push(std::move(o));
 }
 
+void CommsStage::PublishGnssFix(const TeamGnssFix& fix) {
+  Outgoing o;
+  o.kind = Outgoing::Kind::kGnssFix;
+  o.gnss = fix;
+  Push(std::move(o));
+}
+
 void CommsStage::FinishOwnLog() {
   Outgoing o;
   o.kind = Outgoing::Kind::kFinish;
@@ -273,6 +280,9 @@ void CommsStage::PublishOwn(Timestamp now, bool flush) {
       case Outgoing::Kind::kDetection:
         // Teammates hold it until the poses around its time arrive (batched as usual).
         Publish(TeamItemKind::kDetection, TeamItemCodec::Detection(report_.incarnation, o.detection));
+        break;
+      case Outgoing::Kind::kGnssFix:
+        Publish(TeamItemKind::kGnssFix, TeamItemCodec::GnssFix(report_.incarnation, o.gnss));
         break;
       case Outgoing::Kind::kFinish:
         FlushPoses();

@@ -83,6 +83,7 @@ class CommsStage final : public TeamLink {
   void PublishMatch(const TeamMatch& match) override;
   void PublishAttempt(const TeamMatch& pair, bool matched, const std::string& outcome) override;
   void PublishDetection(const TeamDetection& detection) override;
+  void PublishGnssFix(const TeamGnssFix& fix) override;
   bool NextInput(TeamInput* input) override;
   void SetNotify(std::function<void()> notify) override;
   void FinishOwnLog() override;
@@ -92,7 +93,16 @@ class CommsStage final : public TeamLink {
 
  private:
   struct Outgoing {
-    enum class Kind : uint8_t { kSwitch, kEstimate, kSubmap, kMatch, kAttempt, kDetection, kFinish };
+    enum class Kind : uint8_t {
+      kSwitch,
+      kEstimate,
+      kSubmap,
+      kMatch,
+      kAttempt,
+      kDetection,
+      kGnssFix,
+      kFinish
+    };
     Kind kind = Kind::kEstimate;
     FrameSwitchEvent frame_switch;
     OwnEstimate estimate;
@@ -101,6 +111,7 @@ class CommsStage final : public TeamLink {
     bool matched = false;
     std::string outcome;
     TeamDetection detection;
+    TeamGnssFix gnss;
   };
 
   explicit CommsStage(const CommsSetup& setup);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "cairn/exchange.pb.h"
 #include "mapping/submap_codec.h"
@@ -74,6 +75,8 @@ const char* TeamItemKindName(uint16_t kind) {
     case TeamItemKind::kMatch: return "match";
     case TeamItemKind::kAttempt: return "attempt";
     case TeamItemKind::kDetection: return "detection";
+    case TeamItemKind::kGnssFix:
+      return "gnss_fix";
   }
   return "unknown";
 }
@@ -171,6 +174,23 @@ std::string TeamItemCodec::Detection(uint32_t incarnation, const TeamDetection& 
     SetPose(m.mutable_t_observer_observed_alternative(), d.T_observer_observed_alternative, nullptr);
   m.set_distance(d.distance);
   m.set_view_angle(d.view_angle);
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::GnssFix(uint32_t incarnation, const TeamGnssFix& g) {
+  exchange::GnssFixItem m;
+  m.set_incarnation(incarnation);
+  m.set_time_ns(g.fix.time.nanoseconds());
+  m.set_latitude(g.fix.latitude);
+  m.set_longitude(g.fix.longitude);
+  m.set_height(g.fix.height);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m.add_covariance(g.fix.covariance(r, c));
+  }
+  m.set_quality(static_cast<uint32_t>(g.fix.quality));
+  m.set_antenna_x(g.antenna.x());
+  m.set_antenna_y(g.antenna.y());
+  m.set_antenna_z(g.antenna.z());
   return m.SerializeAsString();
 }
 
@@ -312,6 +332,36 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       }
       d.distance = std::isfinite(m.distance()) ? m.distance() : 0.0;
       d.view_angle = std::isfinite(m.view_angle()) ? m.view_angle() : 0.0;
+      return in;
+    }
+    case TeamItemKind::kGnssFix: {
+      exchange::GnssFixItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      in.kind = TeamInput::Kind::kGnssFix;
+      TeamGnssFix& g = in.gnss;
+      g.letter = in.letter;
+      g.run = RunOfIndex(index(in.robot, m.incarnation(), 0));
+      g.fix.time = Timestamp::FromNanoseconds(m.time_ns());
+      g.fix.latitude = m.latitude();
+      g.fix.longitude = m.longitude();
+      g.fix.height = m.height();
+      if (!std::isfinite(g.fix.latitude) || !std::isfinite(g.fix.longitude) || !std::isfinite(g.fix.height) ||
+          std::abs(g.fix.latitude) > std::numbers::pi / 2 || std::abs(g.fix.longitude) > std::numbers::pi) {
+        return DataLossError(what + ": latitude, longitude or height out of range");
+      }
+      if (m.covariance_size() != 9) return DataLossError(what + ": the covariance needs 9 values");
+      for (int k = 0; k < 9; ++k) g.fix.covariance(k / 3, k % 3) = m.covariance(k);
+      if (!g.fix.covariance.allFinite() || (g.fix.covariance - g.fix.covariance.transpose()).norm() > 1e-9 ||
+          g.fix.covariance.llt().info() != Eigen::Success) {
+        return DataLossError(what + ": the covariance is not symmetric positive definite");
+      }
+      const uint32_t q = m.quality();
+      if (q != 1 && q != 2 && q != 4 && q != 5)
+        return DataLossError(what + ": quality " + std::to_string(q) + " is not a fix");
+      g.fix.quality = static_cast<GnssQuality>(q);
+      g.antenna = Eigen::Vector3d(m.antenna_x(), m.antenna_y(), m.antenna_z());
+      if (!g.antenna.allFinite() || g.antenna.norm() > 20.0)
+        return DataLossError(what + ": the antenna is not on the robot");
       return in;
     }
   }

@@ -24,6 +24,7 @@ enum class TeamItemKind : uint16_t {
   kMatch = 5,
   kAttempt = 6,
   kDetection = 7,
+  kGnssFix = 8,
 };
 
 // Which lane an item of `kind` travels in (submaps behind the constraints).
@@ -45,6 +46,7 @@ class TeamItemCodec {
   static std::string Match(const TeamMatch& match);
   static std::string Attempt(const TeamMatch& pair, bool matched, const std::string& outcome);
   static std::string Detection(uint32_t incarnation, const TeamDetection& detection);
+  static std::string GnssFix(uint32_t incarnation, const TeamGnssFix& fix);
 
   // How a decoded item names graph variables: a robot's letter (0 for a robot not in the team
   // file) and the index of its frame `frame` of run `incarnation`.

@@ -198,5 +198,56 @@ TEST(TeamItemCodecTest, RefusesWhatATeammateCouldGetWrong) {
   EXPECT_FALSE(TeamItemCodec::Decode(Item("hexa", TeamItemKind::kFrameSwitch, self.SerializeAsString()), names).ok());
 }
 
+TEST(TeamItemCodecTest, GnssFixRoundTripsAndLiesAreRefused) {
+  TeamGnssFix g;
+  g.fix.time = Timestamp::FromSeconds(42.25);
+  g.fix.latitude = -0.61;
+  g.fix.longitude = 2.63;
+  g.fix.height = 350.5;
+  g.fix.covariance << 2.0, 0.3, 0.0, 0.3, 1.5, 0.0, 0.0, 0.0, 9.0;
+  g.fix.quality = GnssQuality::kRtkFloat;
+  g.antenna = Eigen::Vector3d(0.2, 0.0, 1.1);
+  auto in =
+      TeamItemCodec::Decode(Item("hexa", TeamItemKind::kGnssFix, TeamItemCodec::GnssFix(2, g)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->kind, TeamInput::Kind::kGnssFix);
+  EXPECT_EQ(in->gnss.letter, 'b');
+  EXPECT_EQ(in->gnss.run, 2u);
+  EXPECT_EQ(in->gnss.fix.time, g.fix.time);
+  EXPECT_EQ(in->gnss.fix.latitude, g.fix.latitude);
+  EXPECT_EQ(in->gnss.fix.longitude, g.fix.longitude);
+  EXPECT_EQ(in->gnss.fix.height, g.fix.height);
+  EXPECT_TRUE(in->gnss.fix.covariance.isApprox(g.fix.covariance, 1e-15));
+  EXPECT_EQ(in->gnss.fix.quality, GnssQuality::kRtkFloat);
+  EXPECT_TRUE(in->gnss.antenna.isApprox(g.antenna, 1e-15));
+  auto refused = [&](const TeamGnssFix& bad) {
+    auto out = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kGnssFix, TeamItemCodec::GnssFix(2, bad)),
+                                     TestNames());
+    return out.ok() ? std::string() : out.status().ToString();
+  };
+  TeamGnssFix bad = g;
+  bad.fix.latitude = 2.0;  // beyond the pole
+  EXPECT_NE(refused(bad).find("out of range"), std::string::npos);
+  bad = g;
+  bad.fix.height = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(refused(bad).find("out of range"), std::string::npos);
+  bad = g;
+  bad.fix.covariance(2, 2) = -1.0;
+  EXPECT_NE(refused(bad).find("positive definite"), std::string::npos);
+  bad = g;
+  bad.fix.quality = GnssQuality::kNone;
+  EXPECT_NE(refused(bad).find("not a fix"), std::string::npos);
+  bad = g;
+  bad.antenna.x() = 1e6;
+  EXPECT_NE(refused(bad).find("antenna"), std::string::npos);
+  exchange::GnssFixItem short_covariance;
+  short_covariance.ParseFromString(TeamItemCodec::GnssFix(2, g));
+  short_covariance.mutable_covariance()->RemoveLast();
+  auto out = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kGnssFix, short_covariance.SerializeAsString()),
+                                   TestNames());
+  EXPECT_NE(out.status().ToString().find("9 values"), std::string::npos);
+  EXPECT_NE(out.status().ToString().find("gnss_fix"), std::string::npos);  // names the item
+}
+
 }  // namespace
 }  // namespace cairn

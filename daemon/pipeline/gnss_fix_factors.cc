@@ -50,8 +50,8 @@ Status GnssFixFactors::Check(const GnssFix& fix) const {
   return Status::Ok();
 }
 
-std::vector<SlamFactor> GnssFixFactors::Add(const GnssFix& fix, uint64_t pose_key,
-                                            const Pose3& T_world_body) {
+std::vector<SlamFactor> GnssFixFactors::Add(const GnssFix& fix, uint64_t pose_key, const Pose3& T_world_body,
+                                            const Eigen::Vector3d& antenna) {
   ++counts_.fixes;
   const GeodeticPoint p{fix.latitude, fix.longitude, fix.height};
   const Eigen::Matrix3d R = plane_.R_datum_local(p);
@@ -60,7 +60,8 @@ std::vector<SlamFactor> GnssFixFactors::Add(const GnssFix& fix, uint64_t pose_ke
   h.z_enu = plane_.ToEnu(p);
   h.covariance = R * (0.5 * (fix.covariance + fix.covariance.transpose())) * R.transpose() +
                  options_.min_sigma * options_.min_sigma * Eigen::Matrix3d::Identity();
-  h.antenna_world = T_world_body.t + T_world_body.R() * antenna_;
+  h.antenna = antenna;
+  h.antenna_world = T_world_body.t + T_world_body.R() * antenna;
   std::vector<SlamFactor> out;
   if (counts_.datum_started) {
     out.push_back(FactorOf(h));
@@ -103,7 +104,7 @@ SlamFactor GnssFixFactors::FactorOf(const Held& h) const {
   f.b = h.pose_key;
   f.position = h.z_enu;
   f.position_information = h.covariance.inverse();
-  f.antenna = antenna_;
+  f.antenna = h.antenna;
   return f;
 }
 

@@ -70,10 +70,14 @@ class GnssFixFactors {
   static uint64_t DatumKey();
   // Checks `fix` and converts it to the datum's ENU; an error says why it cannot be used.
   Status Check(const GnssFix& fix) const;
-  // A checked fix at graph pose `pose_key`, whose current estimate is `T_world_body`. Returns the
-  // factors to add now: none while the datum waits for spread; the datum's prior and every held
-  // fix when it starts; afterwards this fix's factor.
-  std::vector<SlamFactor> Add(const GnssFix& fix, uint64_t pose_key, const Pose3& T_world_body);
+  // A checked fix of an antenna at `antenna` in the body of graph pose `pose_key` (this robot's or a
+  // teammate's tied to it), whose current estimate is `T_world_body`. Returns the factors to add
+  // now: none while the datum waits; the datum's prior and every held fix when it starts;
+  // afterwards this fix's factor.
+  std::vector<SlamFactor> Add(const GnssFix& fix, uint64_t pose_key, const Pose3& T_world_body,
+                              const Eigen::Vector3d& antenna);
+  // This robot's antenna, in its body frame.
+  const Eigen::Vector3d& antenna() const { return antenna_; }
   const GnssFixCounts& counts() const { return counts_; }
   void CountRefused() { ++counts_.refused; }
   const LocalTangentPlane& plane() const { return plane_; }
@@ -89,6 +93,7 @@ class GnssFixFactors {
     uint64_t pose_key = 0;
     Eigen::Vector3d z_enu;
     Eigen::Matrix3d covariance;
+    Eigen::Vector3d antenna;
     Eigen::Vector3d antenna_world;
   };
   SlamFactor FactorOf(const Held& h) const;

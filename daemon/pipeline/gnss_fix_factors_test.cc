@@ -168,7 +168,7 @@ TEST(GnssFixFactorsTest, FixesStartTheDatumAndRemoveTheDrift) {
     // Reported in the fix's own ENU axes: isotropic, so the same in the datum's.
     fix.covariance = Eigen::Matrix3d::Identity() * kSigma * kSigma;
     ASSERT_TRUE(gnss.Check(fix).ok());
-    const std::vector<SlamFactor> factors = gnss.Add(fix, x, *graph.Pose(x));
+    const std::vector<SlamFactor> factors = gnss.Add(fix, x, *graph.Pose(x), gnss.antenna());
     if (!gnss.counts().datum_started) {
       EXPECT_TRUE(factors.empty());
       ++factors_before_datum;

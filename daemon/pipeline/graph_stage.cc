@@ -160,6 +160,7 @@ void GraphStage::OnFrameSwitch(const FrameSwitchEvent& e) {
 
 void GraphStage::Finish() {
   if (graph_.num_factors() == 0) return;
+  if (!pending_fixes_.empty()) RetryPendingFixes();
   const SlamUpdateStats stats = graph_.SolveFinal();
   if (stats.solved) ++report_.solves;
   report_.final_cost = stats.cost;
@@ -200,6 +201,8 @@ Status GraphStage::AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64
   ++report_.matches;
   if (robot_a != robot_b) ++report_.team_matches;
   Update();
+  // A match may tie a teammate's subgraph, whose fixes wait for that.
+  if (robot_a != robot_b && !pending_fixes_.empty()) RetryPendingFixes();
   return Status::Ok();
 }
 
@@ -239,6 +242,12 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       if (!pending_detections_.empty()) RetryPendingDetections();
       break;
     }
+    case TeamInput::Kind::kGnssFix: {
+      TeamGnssFix g = in.gnss;
+      g.letter = r;
+      AddGnssFix(g);
+      break;
+    }
     case TeamInput::Kind::kDetection: {
       TeamDetection d = in.detection;
       d.observer_letter = r;
@@ -255,6 +264,8 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       break;
   }
   RetryPendingMatches();
+  // New estimates of a teammate, or a tie to its subgraph, may place its waiting fixes.
+  if (!pending_fixes_.empty() && in.kind != TeamInput::Kind::kGnssFix) RetryPendingFixes();
   Update();
 }
 
@@ -501,6 +512,7 @@ void GraphStage::RetryPendingDetections() {
         std::swap(rec.detection.T_observer_observed, rec.detection.T_observer_observed_alternative);
       ++(d.landmark ? report_.landmark_observations : report_.detections);
       Update();
+      if (!pending_fixes_.empty()) RetryPendingFixes();  // it may tie a teammate's subgraph
     } else {
       rec.status = "graph refused: " + (report_.errors.size() > errors ? report_.errors.back() : std::string("see errors"));
     }
@@ -509,42 +521,70 @@ void GraphStage::RetryPendingDetections() {
   report_.detections_pending = pending_detections_.size();
 }
 
-void GraphStage::AddGnssFix(const GnssFix& fix) {
+bool GraphStage::AddGnssFix(const GnssFix& fix) {
+  return AddGnssFix(TeamGnssFix{robot_, kCurrentRun, fix, gnss_.antenna()});
+}
+
+bool GraphStage::AddGnssFix(const TeamGnssFix& fix) {
   ++report_.gnss_fixes;
-  if (const Status s = gnss_.Check(fix); !s.ok()) {
+  if (const Status s = gnss_.Check(fix.fix); !s.ok()) {
     ++report_.gnss_refused;
-    Error(s.ToString());
-    return;
+    Error(std::string(1, fix.letter) + ": " + s.ToString());
+    return false;
+  }
+  // A teammate never tied to this robot's subgraph must not hold fixes without bound.
+  constexpr size_t kMaxPendingFixes = 4096;
+  if (pending_fixes_.size() == kMaxPendingFixes) {
+    pending_fixes_.erase(pending_fixes_.begin());
+    ++report_.gnss_unplaced;
   }
   pending_fixes_.push_back(fix);
   RetryPendingFixes();
+  return true;
 }
 
 void GraphStage::RetryPendingFixes() {
-  // Fixes come in time order: the first that waits holds the later ones.
-  size_t taken = 0;
-  for (; taken < pending_fixes_.size(); ++taken) {
-    const GnssFix& fix = pending_fixes_[taken];
+  std::set<uint64_t> loose;  // variables not tied to this robot's, computed once when needed
+  bool loose_known = false;
+  size_t kept = 0;
+  for (size_t k = 0; k < pending_fixes_.size(); ++k) {
+    const TeamGnssFix& f = pending_fixes_[k];
     Placed pose;
     Matrix6d covariance;
     std::string why;
-    const PoseLookup lookup = PoseAt(robot_, kCurrentRun, fix.time, &pose, &covariance, &why);
-    if (lookup == PoseLookup::kWait || !graph_.HasVariable(OriginKey(pose.frame_id))) break;
+    const PoseLookup lookup = PoseAt(f.letter, f.run, f.fix.time, &pose, &covariance, &why);
+    const uint64_t origin = VariableKey(VariableKind::kSubmap, f.letter, pose.frame_id);
     if (lookup == PoseLookup::kNever) {
       ++report_.gnss_unplaced;
       continue;
     }
-    const uint64_t key = DetectionPose(robot_, kCurrentRun, fix.time, pose, covariance);
+    bool wait = lookup == PoseLookup::kWait || !graph_.HasVariable(origin);
+    if (!wait && f.letter != robot_) {
+      if (!loose_known) {
+        const std::vector<uint64_t> u = graph_.Unconnected();
+        loose.insert(u.begin(), u.end());
+        loose_known = true;
+      }
+      wait = loose.count(origin) != 0;  // its fix cannot place a floating subgraph
+    }
+    if (wait) {
+      pending_fixes_[kept++] = f;
+      continue;
+    }
+    const uint64_t key = DetectionPose(f.letter, f.run, f.fix.time, pose, covariance);
     const auto T_world_body = graph_.Pose(key);
     if (!T_world_body.ok()) {
       ++report_.gnss_unplaced;
       continue;
     }
+    const uint64_t before = gnss_.counts().factors;
     bool added = false;
-    for (const SlamFactor& f : gnss_.Add(fix, key, *T_world_body)) added = Add(f) || added;
+    for (const SlamFactor& factor : gnss_.Add(f.fix, key, *T_world_body, f.antenna))
+      added = Add(factor) || added;
+    if (f.letter != robot_) report_.gnss_team_factors += gnss_.counts().factors - before;
     if (added) Update();
   }
-  pending_fixes_.erase(pending_fixes_.begin(), pending_fixes_.begin() + static_cast<long>(taken));
+  pending_fixes_.resize(kept);
   report_.gnss_factors = gnss_.counts().factors;
   report_.gnss_pending = pending_fixes_.size() + gnss_.counts().held;
   report_.gnss_datum = gnss_.counts().datum_started;

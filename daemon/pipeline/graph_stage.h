@@ -57,8 +57,9 @@ struct GraphStageReport {
   uint64_t gnss_factors = 0;     // fixes that entered the graph
   uint64_t gnss_refused = 0;     // no solution, not finite, too inaccurate
   uint64_t gnss_unplaced = 0;    // no estimate of the robot at their time
+  uint64_t gnss_team_factors = 0;  // of the factors, teammates' fixes
   uint64_t gnss_pending = 0;     // waiting for estimates, or for the datum to start
-  bool gnss_datum = false;       // the datum is estimated (fixes spread far enough)
+  bool gnss_datum = false;       // the datum is estimated (the fixes give its yaw)
   double chi2 = 0.0;             // after the final solve
   double final_cost = 0.0;
   std::vector<std::string> errors;  // the first few, verbatim
@@ -105,7 +106,12 @@ class GraphStage {
   // A GNSS fix of this robot's antenna: once the filter's estimates cover its time it becomes a graph
   // pose x there (as for a detection) and, after the datum has started, a factor from the datum
   // (gnss_fix_factors.h). Refused fixes are counted with the first reasons in the report's errors.
-  void AddGnssFix(const GnssFix& fix);
+  // Returns whether it was taken (teammates get those).
+  bool AddGnssFix(const GnssFix& fix);
+  // A teammate's fix (or this robot's, by its letter and run): the same, once that robot's
+  // estimates cover its time and its subgraph is tied to this robot's; until then it waits.
+  bool AddGnssFix(const TeamGnssFix& fix);
+  const Eigen::Vector3d& gnss_antenna() const { return gnss_.antenna(); }
   // T_world_enu of the GNSS datum; false before fixes have started it.
   bool Datum(Eigen::Isometry3d* T_world_enu) const;
   // Landmark carriers by name: the index of each is its variable's.
@@ -216,7 +222,7 @@ class GraphStage {
   void RetryPendingDetections();
   void RetryPendingFixes();
   GnssFixFactors gnss_;
-  std::vector<GnssFix> pending_fixes_;
+  std::vector<TeamGnssFix> pending_fixes_;
   // Whether a sighting of a robot agrees with both robots' gravity (their estimates' roll and
   // pitch); if only IPPE's other minimum does, `T_observer_observed` becomes it and `chosen` says so.
   bool AgreesWithGravity(const TeamDetection& d, const Placed& observer, const Placed& observed,

@@ -603,6 +603,20 @@ TEST(GraphStageTest, ThisRobotsEarlierRunJoinsItsGraphAsARunOfItsOwn) {
   EXPECT_LT((t.poses[80].T_frame_body.translation() - (Offset() * a.T_world_body[80]).translation()).norm(), 0.05);
 }
 
+// A fix of the antenna at `antenna` on a body at T_world_body, the datum at T_world_enu.
+GnssFix FixOf(const Eigen::Isometry3d& T_world_body, const Eigen::Vector3d& antenna,
+              const Eigen::Isometry3d& T_world_enu, const LocalTangentPlane& plane, Timestamp time) {
+  const GeodeticPoint p = plane.ToGeodetic(T_world_enu.inverse() * (T_world_body * antenna));
+  GnssFix fix;
+  fix.time = time;
+  fix.latitude = p.latitude;
+  fix.longitude = p.longitude;
+  fix.height = p.height;
+  fix.covariance = Eigen::Matrix3d::Identity() * 0.01;
+  fix.quality = GnssQuality::kDifferential;
+  return fix;
+}
+
 TEST(GraphStageTest, GnssFixesStartTheDatumAndAreCountedWhenRefusedOrUnplaced) {
   const Drive d = MakeDrive(120, 25);
   GraphStageOptions o = Options();
@@ -617,17 +631,8 @@ TEST(GraphStageTest, GnssFixesStartTheDatumAndAreCountedWhenRefusedOrUnplaced) {
   T_world_enu.linear() = Eigen::AngleAxisd(-0.8, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   T_world_enu.translation() = Eigen::Vector3d(40.0, -25.0, 3.0);
   auto fix_at = [&](int i) {
-    const Eigen::Vector3d enu =
-        T_world_enu.inverse() * (d.T_world_body[static_cast<size_t>(i)] * Eigen::Vector3d(0, 0, 0.5));
-    const GeodeticPoint p = plane.ToGeodetic(enu);
-    GnssFix fix;
-    fix.time = Timestamp::FromNanoseconds(int64_t{100000000} * i);
-    fix.latitude = p.latitude;
-    fix.longitude = p.longitude;
-    fix.height = p.height;
-    fix.covariance = Eigen::Matrix3d::Identity() * 0.01;
-    fix.quality = GnssQuality::kDifferential;
-    return fix;
+    return FixOf(d.T_world_body[static_cast<size_t>(i)], Eigen::Vector3d(0, 0, 0.5), T_world_enu, plane,
+                 Timestamp::FromNanoseconds(int64_t{100000000} * i));
   };
   GnssFix early = fix_at(0);
   early.time = early.time - Duration::Seconds(1.0);  // before the filter's first estimate
@@ -670,6 +675,59 @@ TEST(GraphStageTest, GnssFixesStartTheDatumAndAreCountedWhenRefusedOrUnplaced) {
   EXPECT_EQ(g.Robots(), std::vector<char>{'a'});
   const PoseGraph exported = g.ExportPoseGraph();
   for (uint64_t id : exported.ids()) EXPECT_NE(KindOfKey(id), VariableKind::kDatum);
+}
+
+// A teammate's fixes wait while its subgraph floats (a fix cannot place it) and enter once a
+// sighting ties it to ours; they are fixes of its own antenna.
+TEST(GraphStageTest, ATeammatesGnssFixesWaitUntilItsSubgraphIsTied) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStageOptions o = Options();
+  o.gnss.enabled = true;
+  o.gnss.datum_latitude = -20.0;
+  o.gnss.datum_longitude = -68.0;
+  GraphStage g(o, /*deterministic=*/true);
+  const LocalTangentPlane plane(
+      GeodeticPoint{-20.0 * std::numbers::pi / 180, -68.0 * std::numbers::pi / 180, 0.0});
+  Eigen::Isometry3d T_world_enu = Eigen::Isometry3d::Identity();
+  T_world_enu.linear() = Eigen::AngleAxisd(1.9, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_world_enu.translation() = Eigen::Vector3d(-7.0, 12.0, 0.5);
+  const Eigen::Vector3d antenna_b(0.0, 0.1, 0.3);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (int i = 5; i < 95; i += 10) {
+    g.AddGnssFix(FixOf(a.T_world_body[static_cast<size_t>(i)], Eigen::Vector3d::Zero(), T_world_enu, plane,
+                       Timestamp::FromNanoseconds(int64_t{100000000} * i)));
+  }
+  ASSERT_TRUE(g.report().gnss_datum);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 7)) g.OnTeamInput(in);
+  size_t b_fixes = 0;
+  for (int i = 3; i < 95; i += 10, ++b_fixes) {
+    TeamInput in;
+    in.kind = TeamInput::Kind::kGnssFix;
+    in.robot = "b";
+    in.letter = 'b';
+    in.gnss.antenna = antenna_b;
+    in.gnss.fix = FixOf(Offset() * b.T_world_body[static_cast<size_t>(i)], antenna_b, T_world_enu, plane,
+                        Timestamp::FromNanoseconds(int64_t{100000000} * i));
+    g.OnTeamInput(in);
+  }
+  EXPECT_EQ(g.report().gnss_team_factors, 0u);
+  EXPECT_EQ(g.report().gnss_pending, b_fixes);
+  g.AddDetection(Sighting(a, b, 60), true, "");
+  ASSERT_TRUE(g.Connected('b'));
+  g.Finish();
+  const GraphStageReport r = g.report();
+  EXPECT_EQ(r.gnss_team_factors, b_fixes);
+  EXPECT_EQ(r.gnss_pending, 0u);
+  EXPECT_EQ(r.rejected_factors, 0u);
+  // b's fixes agree with the sighting: its trajectory stays where it truly was.
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_EQ(tb.poses.size(), 100u);
+  for (size_t i = 0; i < tb.poses.size(); i += 9) {
+    EXPECT_LT((tb.poses[i].T_frame_body.translation() - (Offset() * b.T_world_body[i]).translation()).norm(),
+              0.05)
+        << i;
+  }
 }
 
 }  // namespace

@@ -634,7 +634,9 @@ void Pipeline::TakeSightings(Timestamp before) {
 void Pipeline::TakeGnssFixes(Timestamp before) {
   while (const QueuedFix* queued = gnss_queue_.Front()) {
     if (!(queued->after < before)) return;
-    graph_->AddGnssFix(queued->fix);
+    if (graph_->AddGnssFix(queued->fix) && team_) {
+      team_->PublishGnssFix(TeamGnssFix{graph_->robot(), kCurrentRun, queued->fix, graph_->gnss_antenna()});
+    }
     gnss_queue_.PopFront();
   }
 }

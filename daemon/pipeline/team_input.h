@@ -12,6 +12,7 @@
 
 #include "common/timestamp.h"
 #include "estimation/graph/pose_graph.h"
+#include "hal/gnss_fix.h"
 #include "mapping/matching/four_dof_transform.h"
 #include "mapping/submap.h"
 
@@ -82,8 +83,25 @@ struct TeamDetection {
   double view_angle = 0.0;  // rad, tag normal to the line of sight
 };
 
+// A GNSS fix of a robot's antenna (at `antenna` in its body frame), during its run `run`.
+struct TeamGnssFix {
+  char letter = 0;
+  uint32_t run = kCurrentRun;
+  GnssFix fix;
+  Eigen::Vector3d antenna = Eigen::Vector3d::Zero();
+};
+
 struct TeamInput {
-  enum class Kind : uint8_t { kRunStart, kFrameSwitch, kPoses, kSubmap, kMatch, kAttempt, kDetection };
+  enum class Kind : uint8_t {
+    kRunStart,
+    kFrameSwitch,
+    kPoses,
+    kSubmap,
+    kMatch,
+    kAttempt,
+    kDetection,
+    kGnssFix
+  };
   Kind kind = Kind::kRunStart;
   std::string robot;   // the item's origin
   char letter = 0;     // its graph letter (from the team file)
@@ -105,6 +123,8 @@ struct TeamInput {
   std::string outcome;
   // kDetection
   TeamDetection detection;
+  // kGnssFix
+  TeamGnssFix gnss;
 };
 
 }  // namespace cairn

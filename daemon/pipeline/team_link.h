@@ -23,6 +23,8 @@ class TeamLink {
   virtual void PublishAttempt(const TeamMatch& pair, bool matched, const std::string& outcome) = 0;
   // A sighting of a teammate's or a landmark's tag (robot detection d, landmark observation o).
   virtual void PublishDetection(const TeamDetection& detection) = 0;
+  // A GNSS fix the graph took (its letter and run are this robot's).
+  virtual void PublishGnssFix(const TeamGnssFix& fix) = 0;
   // Teammates' items not taken yet; false when there are none.
   virtual bool NextInput(TeamInput* input) = 0;
   // Called (from the comms thread) when inputs arrive, to wake the graph thread.
