@@ -178,7 +178,7 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("fixes", g.gnss_fixes)
         .Field("factors", g.gnss_factors)
         .Field("team_factors", g.gnss_team_factors);
-    j.Field("refused", g.gnss_refused);
+    j.Field("placed_subgraphs", g.gnss_placed_subgraphs).Field("refused", g.gnss_refused);
     j.Field("unplaced", g.gnss_unplaced).Field("pending", g.gnss_pending);
     // Where the datum's east-north-up frame lies in the graph's world: the map's geo-reference.
     if (Eigen::Isometry3d T_world_enu; graph->Datum(&T_world_enu)) {

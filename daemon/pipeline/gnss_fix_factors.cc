@@ -71,14 +71,14 @@ std::vector<SlamFactor> GnssFixFactors::Add(const GnssFix& fix, uint64_t pose_ke
   if (held_.size() == kMaxHeld) held_.erase(held_.begin());
   held_.push_back(h);
   counts_.held = held_.size();
-  if (HeldYawSigma() > options_.start_yaw_sigma) return out;
   std::vector<Eigen::Vector3d> world, enu;
   std::vector<double> weights;
   for (const Held& k : held_) {
     world.push_back(k.antenna_world);
     enu.push_back(k.z_enu);
-    weights.push_back(2.0 / k.covariance.topLeftCorner<2, 2>().trace());
+    weights.push_back(Weight(k.covariance));
   }
+  if (YawSigma(world, weights) > options_.start_yaw_sigma) return out;
   const Expected<Pose3> T_world_enu = FitDatum(world, enu, weights);
   if (!T_world_enu.ok()) return out;
   SlamFactor prior;
@@ -108,23 +108,44 @@ SlamFactor GnssFixFactors::FactorOf(const Held& h) const {
   return f;
 }
 
-double GnssFixFactors::HeldYawSigma() const {
+double GnssFixFactors::YawSigma(const std::vector<Eigen::Vector3d>& points,
+                                const std::vector<double>& weights) {
   // Fisher information of a rotation about the vertical: sum of w_i |p_i - p_mean|^2 horizontally.
   double total = 0.0;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const Held& h : held_) {
-    const double w = 2.0 / h.covariance.topLeftCorner<2, 2>().trace();
-    total += w;
-    mean += w * h.antenna_world.head<2>();
+  for (size_t i = 0; i < points.size(); ++i) {
+    total += weights[i];
+    mean += weights[i] * points[i].head<2>();
   }
   if (!(total > 0.0)) return std::numeric_limits<double>::infinity();
   mean /= total;
   double information = 0.0;
-  for (const Held& h : held_) {
-    information +=
-        2.0 / h.covariance.topLeftCorner<2, 2>().trace() * (h.antenna_world.head<2>() - mean).squaredNorm();
-  }
+  for (size_t i = 0; i < points.size(); ++i)
+    information += weights[i] * (points[i].head<2>() - mean).squaredNorm();
   return information > 0.0 ? 1.0 / std::sqrt(information) : std::numeric_limits<double>::infinity();
+}
+
+double GnssFixFactors::Weight(const Eigen::Matrix3d& covariance) {
+  return 2.0 / covariance.topLeftCorner<2, 2>().trace();
+}
+
+Expected<Pose3> GnssFixFactors::PlaceFloating(const std::vector<GnssFix>& fixes,
+                                              const std::vector<Eigen::Vector3d>& antenna_floating,
+                                              const Pose3& T_world_enu) const {
+  std::vector<Eigen::Vector3d> world, floating;
+  std::vector<double> weights;
+  for (size_t i = 0; i < fixes.size(); ++i) {
+    const GeodeticPoint p{fixes[i].latitude, fixes[i].longitude, fixes[i].height};
+    const Eigen::Matrix3d R = plane_.R_datum_local(p);
+    weights.push_back(Weight(R * fixes[i].covariance * R.transpose() +
+                             options_.min_sigma * options_.min_sigma * Eigen::Matrix3d::Identity()));
+    world.push_back(T_world_enu.t + T_world_enu.q * plane_.ToEnu(p));
+    floating.push_back(antenna_floating[i]);
+  }
+  if (YawSigma(floating, weights) > options_.start_yaw_sigma) {
+    return FailedPreconditionError("the fixes do not fix the subgraph's yaw yet");
+  }
+  return FitDatum(world, floating, weights);
 }
 
 Expected<Pose3> GnssFixFactors::FitDatum(const std::vector<Eigen::Vector3d>& p_world,

@@ -82,6 +82,15 @@ class GnssFixFactors {
   void CountRefused() { ++counts_.refused; }
   const LocalTangentPlane& plane() const { return plane_; }
 
+  // The sigma of a yaw fitted to weighted points (infinite while they coincide): the robot's
+  // positions at its fixes, not the fixes' own scatter, which noise alone would grow.
+  static double YawSigma(const std::vector<Eigen::Vector3d>& points, const std::vector<double>& weights);
+  // The rigid (yaw and translation) move that puts a floating subgraph onto the datum at
+  // T_world_enu: `fixes` of antennas at `antenna_floating` in the subgraph's frame. An error while
+  // they do not fix its yaw to start_yaw_sigma.
+  Expected<Pose3> PlaceFloating(const std::vector<GnssFix>& fixes,
+                                const std::vector<Eigen::Vector3d>& antenna_floating,
+                                const Pose3& T_world_enu) const;
   // Weighted fit of T_world_enu (yaw and translation; level) to antenna positions in the world and
   // the same positions in ENU with their horizontal weights. Needs two distinct points.
   static Expected<Pose3> FitDatum(const std::vector<Eigen::Vector3d>& p_world,
@@ -97,8 +106,8 @@ class GnssFixFactors {
     Eigen::Vector3d antenna_world;
   };
   SlamFactor FactorOf(const Held& h) const;
-  // The sigma of the datum's yaw that the held fixes give (infinite while the robot stood still).
-  double HeldYawSigma() const;
+  // The horizontal weight of a fix of covariance `covariance` (m^2, ENU).
+  static double Weight(const Eigen::Matrix3d& covariance);
 
   GnssFixOptions options_;
   LocalTangentPlane plane_;

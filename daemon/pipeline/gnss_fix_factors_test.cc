@@ -221,5 +221,29 @@ TEST(GnssFixFactorsTest, GraphRefusesFixesOnUnknownOrFloatingPoses) {
   EXPECT_NE(graph.AddFactor(wrong).ToString().find("does not fit"), std::string::npos);
 }
 
+TEST(GnssFixFactorsTest, AFloatingComponentIsPlacedRigidlyAndJoinsTheOwn) {
+  SlamGraph graph;
+  SlamFactor prior;
+  prior.kind = FactorKind::kPrior;
+  prior.a = VariableKey(VariableKind::kSubmap, 'a', 0);
+  ASSERT_TRUE(graph.AddFactor(prior).ok());
+  SlamFactor w;  // b's two origins, floating
+  w.kind = FactorKind::kFrameSwitch;
+  w.a = VariableKey(VariableKind::kSubmap, 'b', 0);
+  w.b = VariableKey(VariableKind::kSubmap, 'b', 1);
+  w.z = GnssTestPose(5.0, 0.0, 0.0, 0.5);
+  ASSERT_TRUE(graph.AddFactor(w).ok());
+  EXPECT_EQ(graph.Unconnected().size(), 2u);
+  EXPECT_FALSE(graph.PlaceComponent(prior.a, Pose3()).ok());  // already the own robot's
+  EXPECT_FALSE(graph.PlaceComponent(VariableKey(VariableKind::kSubmap, 'c', 0), Pose3()).ok());
+  const Pose3 correction = GnssTestPose(10.0, -3.0, 0.0, 1.2);
+  const Pose3 before = *graph.Pose(w.b);
+  ASSERT_TRUE(graph.PlaceComponent(w.b, correction).ok());
+  EXPECT_TRUE(graph.Unconnected().empty());
+  const Pose3 after = *graph.Pose(w.b), expected = correction * before;
+  EXPECT_LT((after.t - expected.t).norm(), 1e-12);
+  EXPECT_LT(after.q.angularDistance(expected.q), 1e-12);
+}
+
 }  // namespace
 }  // namespace cairn

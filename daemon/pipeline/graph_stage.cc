@@ -546,6 +546,12 @@ bool GraphStage::AddGnssFix(const TeamGnssFix& fix) {
 void GraphStage::RetryPendingFixes() {
   std::set<uint64_t> loose;  // variables not tied to this robot's, computed once when needed
   bool loose_known = false;
+  struct FloatingFixes {
+    uint64_t key = 0;  // a variable of the subgraph
+    std::vector<GnssFix> fixes;
+    std::vector<Eigen::Vector3d> antenna_floating;
+  };
+  std::map<RunKey, FloatingFixes> floating;
   size_t kept = 0;
   for (size_t k = 0; k < pending_fixes_.size(); ++k) {
     const TeamGnssFix& f = pending_fixes_[k];
@@ -567,6 +573,16 @@ void GraphStage::RetryPendingFixes() {
       }
       wait = loose.count(origin) != 0;  // its fix cannot place a floating subgraph
     }
+    if (wait && lookup == PoseLookup::kReady && graph_.HasVariable(origin)) {
+      // Placeable in its floating subgraph: a candidate for placing that subgraph by its fixes.
+      const uint64_t key = DetectionPose(f.letter, f.run, f.fix.time, pose, covariance);
+      if (const auto T_floating_body = graph_.Pose(key); T_floating_body.ok()) {
+        FloatingFixes& run = floating[RunKey{f.letter, f.run}];
+        run.key = key;
+        run.fixes.push_back(f.fix);
+        run.antenna_floating.push_back(T_floating_body->t + T_floating_body->q * f.antenna);
+      }
+    }
     if (wait) {
       pending_fixes_[kept++] = f;
       continue;
@@ -585,6 +601,25 @@ void GraphStage::RetryPendingFixes() {
     if (added) Update();
   }
   pending_fixes_.resize(kept);
+  // A teammate never tied to this robot (no match, no sighting) is placed by its own fixes once
+  // they fix its yaw; then its fixes tie it.
+  bool placed = false;
+  Eigen::Isometry3d T_world_enu;
+  if (!floating.empty() && Datum(&T_world_enu)) {
+    for (const auto& [run, f] : floating) {
+      const Expected<Pose3> correction =
+          gnss_.PlaceFloating(f.fixes, f.antenna_floating, ToPose3(T_world_enu));
+      if (!correction.ok()) continue;
+      if (graph_.PlaceComponent(f.key, *correction).ok()) {
+        ++report_.gnss_placed_subgraphs;
+        placed = true;
+      }
+    }
+  }
+  if (placed) {
+    RetryPendingFixes();
+    return;
+  }
   report_.gnss_factors = gnss_.counts().factors;
   report_.gnss_pending = pending_fixes_.size() + gnss_.counts().held;
   report_.gnss_datum = gnss_.counts().datum_started;

@@ -58,6 +58,7 @@ struct GraphStageReport {
   uint64_t gnss_refused = 0;     // no solution, not finite, too inaccurate
   uint64_t gnss_unplaced = 0;    // no estimate of the robot at their time
   uint64_t gnss_team_factors = 0;  // of the factors, teammates' fixes
+  uint64_t gnss_placed_subgraphs = 0;  // teammates' subgraphs placed by their fixes alone
   uint64_t gnss_pending = 0;     // waiting for estimates, or for the datum to start
   bool gnss_datum = false;       // the datum is estimated (the fixes give its yaw)
   double chi2 = 0.0;             // after the final solve

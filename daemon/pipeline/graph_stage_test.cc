@@ -677,8 +677,8 @@ TEST(GraphStageTest, GnssFixesStartTheDatumAndAreCountedWhenRefusedOrUnplaced) {
   for (uint64_t id : exported.ids()) EXPECT_NE(KindOfKey(id), VariableKind::kDatum);
 }
 
-// A teammate's fixes wait while its subgraph floats (a fix cannot place it) and enter once a
-// sighting ties it to ours; they are fixes of its own antenna.
+// A teammate's fixes wait while its subgraph floats and they cannot place it (two fixes 1 m apart
+// leave its yaw open), and enter once a sighting ties it to ours; they are of its own antenna.
 TEST(GraphStageTest, ATeammatesGnssFixesWaitUntilItsSubgraphIsTied) {
   const Drive a = MakeDrive(100, 25);
   const Drive b = MakeDrive(100, 20);
@@ -701,7 +701,7 @@ TEST(GraphStageTest, ATeammatesGnssFixesWaitUntilItsSubgraphIsTied) {
   ASSERT_TRUE(g.report().gnss_datum);
   for (const TeamInput& in : TeamInputsOf(b, 'b', 7)) g.OnTeamInput(in);
   size_t b_fixes = 0;
-  for (int i = 3; i < 95; i += 10, ++b_fixes) {
+  for (int i = 3; i < 20; i += 10, ++b_fixes) {
     TeamInput in;
     in.kind = TeamInput::Kind::kGnssFix;
     in.robot = "b";
@@ -726,6 +726,53 @@ TEST(GraphStageTest, ATeammatesGnssFixesWaitUntilItsSubgraphIsTied) {
   for (size_t i = 0; i < tb.poses.size(); i += 9) {
     EXPECT_LT((tb.poses[i].T_frame_body.translation() - (Offset() * b.T_world_body[i]).translation()).norm(),
               0.05)
+        << i;
+  }
+}
+
+// Robots that never meet: a teammate's subgraph, neither matched nor seen, is placed by its own
+// fixes once they fix its yaw, and lands where it truly is.
+TEST(GraphStageTest, ATeammateNeverMetIsPlacedByItsGnssFixes) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStageOptions o = Options();
+  o.gnss.enabled = true;
+  o.gnss.datum_latitude = 64.1;
+  o.gnss.datum_longitude = -21.9;
+  GraphStage g(o, /*deterministic=*/true);
+  const LocalTangentPlane plane(
+      GeodeticPoint{64.1 * std::numbers::pi / 180, -21.9 * std::numbers::pi / 180, 0.0});
+  Eigen::Isometry3d T_world_enu = Eigen::Isometry3d::Identity();
+  T_world_enu.linear() = Eigen::AngleAxisd(-2.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_world_enu.translation() = Eigen::Vector3d(3.0, 4.0, -1.0);
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (int i = 5; i < 95; i += 10) {
+    g.AddGnssFix(FixOf(a.T_world_body[static_cast<size_t>(i)], Eigen::Vector3d::Zero(), T_world_enu, plane,
+                       Timestamp::FromNanoseconds(int64_t{100000000} * i)));
+  }
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 7)) g.OnTeamInput(in);
+  EXPECT_FALSE(g.Connected('b'));
+  for (int i = 3; i < 95; i += 10) {
+    TeamInput in;
+    in.kind = TeamInput::Kind::kGnssFix;
+    in.robot = "b";
+    in.letter = 'b';
+    in.gnss.fix = FixOf(Offset() * b.T_world_body[static_cast<size_t>(i)], Eigen::Vector3d::Zero(),
+                        T_world_enu, plane, Timestamp::FromNanoseconds(int64_t{100000000} * i));
+    g.OnTeamInput(in);
+  }
+  ASSERT_TRUE(g.Connected('b'));
+  g.Finish();
+  const GraphStageReport r = g.report();
+  EXPECT_EQ(r.gnss_placed_subgraphs, 1u);
+  EXPECT_EQ(r.gnss_pending, 0u);
+  EXPECT_EQ(r.detections, 0u);
+  EXPECT_EQ(r.team_matches, 0u);
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_EQ(tb.poses.size(), 100u);
+  for (size_t i = 0; i < tb.poses.size(); i += 9) {
+    EXPECT_LT((tb.poses[i].T_frame_body.translation() - (Offset() * b.T_world_body[i]).translation()).norm(),
+              0.1)
         << i;
   }
 }

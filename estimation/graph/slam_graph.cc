@@ -475,6 +475,16 @@ std::vector<uint64_t> SlamGraph::Unconnected() const {
   return out;
 }
 
+Status SlamGraph::PlaceComponent(uint64_t key, const Pose3& correction) {
+  auto it = variables_.find(key);
+  if (it == variables_.end()) return NotFoundError("no variable " + std::to_string(key));
+  if (own_component_ < 0 || it->second.component == own_component_) {
+    return InvalidArgumentError("variable " + std::to_string(key) + " is not in a floating component");
+  }
+  JoinComponents(own_component_, it->second.component, correction);
+  return Status::Ok();
+}
+
 std::vector<uint64_t> SlamGraph::VariableKeys() const {
   std::vector<uint64_t> keys;
   keys.reserve(variables_.size());

@@ -144,6 +144,10 @@ class SlamGraph {
   Expected<Pose3> GlobalPose(char robot, const Pose3& T_s_x) const;
   // Variables not connected to the own robot's prior.
   std::vector<uint64_t> Unconnected() const;
+  // Moves the floating component holding `key` rigidly by `correction` (left-multiplied) and makes
+  // it part of the own robot's, for a placement found outside the graph (GNSS fixes of a robot
+  // never matched or seen); factors added next must tie it. Error when `key` is unknown or tied.
+  Status PlaceComponent(uint64_t key, const Pose3& correction);
   // Factors waiting for a variable to become reachable.
   size_t pending_factors() const { return pending_.size(); }
   size_t num_factors() const { return num_added_factors_; }
