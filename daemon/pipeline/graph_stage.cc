@@ -593,11 +593,13 @@ void GraphStage::RetryPendingFixes() {
       ++report_.gnss_unplaced;
       continue;
     }
-    const uint64_t before = gnss_.counts().factors;
     bool added = false;
-    for (const SlamFactor& factor : gnss_.Add(f.fix, key, *T_world_body, f.antenna))
-      added = Add(factor) || added;
-    if (f.letter != robot_) report_.gnss_team_factors += gnss_.counts().factors - before;
+    for (const SlamFactor& factor : gnss_.Add(f.fix, key, *T_world_body, f.antenna)) {
+      if (!Add(factor)) continue;
+      added = true;
+      if (factor.kind == FactorKind::kGnssPosition && RobotOfVariable(factor.b) != robot_)
+        ++report_.gnss_team_factors;
+    }
     if (added) Update();
   }
   pending_fixes_.resize(kept);
