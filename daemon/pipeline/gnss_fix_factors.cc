@@ -53,13 +53,10 @@ Status GnssFixFactors::Check(const GnssFix& fix) const {
 std::vector<SlamFactor> GnssFixFactors::Add(const GnssFix& fix, uint64_t pose_key, const Pose3& T_world_body,
                                             const Eigen::Vector3d& antenna) {
   ++counts_.fixes;
-  const GeodeticPoint p{fix.latitude, fix.longitude, fix.height};
-  const Eigen::Matrix3d R = plane_.R_datum_local(p);
   Held h;
   h.pose_key = pose_key;
-  h.z_enu = plane_.ToEnu(p);
-  h.covariance = R * (0.5 * (fix.covariance + fix.covariance.transpose())) * R.transpose() +
-                 options_.min_sigma * options_.min_sigma * Eigen::Matrix3d::Identity();
+  h.z_enu = plane_.ToEnu(GeodeticPoint{fix.latitude, fix.longitude, fix.height});
+  h.covariance = CovarianceInDatum(fix);
   h.antenna = antenna;
   h.antenna_world = T_world_body.t + T_world_body.R() * antenna;
   std::vector<SlamFactor> out;
@@ -125,6 +122,12 @@ double GnssFixFactors::YawSigma(const std::vector<Eigen::Vector3d>& points,
   return information > 0.0 ? 1.0 / std::sqrt(information) : std::numeric_limits<double>::infinity();
 }
 
+Eigen::Matrix3d GnssFixFactors::CovarianceInDatum(const GnssFix& fix) const {
+  const Eigen::Matrix3d R = plane_.R_datum_local(GeodeticPoint{fix.latitude, fix.longitude, fix.height});
+  return R * (0.5 * (fix.covariance + fix.covariance.transpose())) * R.transpose() +
+         options_.min_sigma * options_.min_sigma * Eigen::Matrix3d::Identity();
+}
+
 double GnssFixFactors::Weight(const Eigen::Matrix3d& covariance) {
   return 2.0 / covariance.topLeftCorner<2, 2>().trace();
 }
@@ -132,20 +135,17 @@ double GnssFixFactors::Weight(const Eigen::Matrix3d& covariance) {
 Expected<Pose3> GnssFixFactors::PlaceFloating(const std::vector<GnssFix>& fixes,
                                               const std::vector<Eigen::Vector3d>& antenna_floating,
                                               const Pose3& T_world_enu) const {
-  std::vector<Eigen::Vector3d> world, floating;
+  std::vector<Eigen::Vector3d> world;
   std::vector<double> weights;
-  for (size_t i = 0; i < fixes.size(); ++i) {
-    const GeodeticPoint p{fixes[i].latitude, fixes[i].longitude, fixes[i].height};
-    const Eigen::Matrix3d R = plane_.R_datum_local(p);
-    weights.push_back(Weight(R * fixes[i].covariance * R.transpose() +
-                             options_.min_sigma * options_.min_sigma * Eigen::Matrix3d::Identity()));
-    world.push_back(T_world_enu.t + T_world_enu.q * plane_.ToEnu(p));
-    floating.push_back(antenna_floating[i]);
+  for (const GnssFix& fix : fixes) {
+    weights.push_back(Weight(CovarianceInDatum(fix)));
+    world.push_back(T_world_enu.t +
+                    T_world_enu.q * plane_.ToEnu(GeodeticPoint{fix.latitude, fix.longitude, fix.height}));
   }
-  if (YawSigma(floating, weights) > options_.start_yaw_sigma) {
+  if (YawSigma(antenna_floating, weights) > options_.start_yaw_sigma) {
     return FailedPreconditionError("the fixes do not fix the subgraph's yaw yet");
   }
-  return FitDatum(world, floating, weights);
+  return FitDatum(world, antenna_floating, weights);
 }
 
 Expected<Pose3> GnssFixFactors::FitDatum(const std::vector<Eigen::Vector3d>& p_world,

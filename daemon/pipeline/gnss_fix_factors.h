@@ -56,7 +56,6 @@ struct GnssFixOptions {
 
 struct GnssFixCounts {
   uint64_t fixes = 0;    // given
-  uint64_t refused = 0;  // no solution, not finite, or worse than max_sigma
   uint64_t factors = 0;  // entered the graph
   uint64_t held = 0;     // waiting for the datum to start
   bool datum_started = false;
@@ -79,8 +78,6 @@ class GnssFixFactors {
   // This robot's antenna, in its body frame.
   const Eigen::Vector3d& antenna() const { return antenna_; }
   const GnssFixCounts& counts() const { return counts_; }
-  void CountRefused() { ++counts_.refused; }
-  const LocalTangentPlane& plane() const { return plane_; }
 
   // The sigma of a yaw fitted to weighted points (infinite while they coincide): the robot's
   // positions at its fixes, not the fixes' own scatter, which noise alone would grow.
@@ -106,6 +103,8 @@ class GnssFixFactors {
     Eigen::Vector3d antenna_world;
   };
   SlamFactor FactorOf(const Held& h) const;
+  // The fix's stated accuracy in the datum's axes, floored by min_sigma.
+  Eigen::Matrix3d CovarianceInDatum(const GnssFix& fix) const;
   // The horizontal weight of a fix of covariance `covariance` (m^2, ENU).
   static double Weight(const Eigen::Matrix3d& covariance);
 
