@@ -6,13 +6,14 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/scoped_temp_dir.h"
+
 namespace cairn {
 namespace {
 
 TEST(AtomicFileTest, ReplacesContentsWithoutLeavingTemporaries) {
-  const auto dir = std::filesystem::temp_directory_path() / "cairn_atomic_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const testing::ScopedTempDir temp("atomic_file");
+  const std::filesystem::path dir = temp.path();
   const std::string path = (dir / "f.json").string();
   ASSERT_TRUE(WriteFileAtomically(path, "old").ok());
   ASSERT_TRUE(WriteFileAtomically(path, "new contents").ok());

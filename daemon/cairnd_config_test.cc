@@ -10,6 +10,7 @@
 
 #include "sim/sim_robot.h"
 #include "sim/terrain.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -66,7 +67,8 @@ TEST(EarlierRunConfigTest, LoadsWithDefaultsAndNotesTheDifferences) {
   ASSERT_NE(yaml.find(ncc), std::string::npos);
   yaml.erase(yaml.find(dof), yaml.find('\n', yaml.find(dof)) - yaml.find(dof) + 1);
   yaml.replace(yaml.find(ncc), ncc.size(), "\n    old_match_ncc:");
-  const std::string path = testing::FreshTempDir("earlier_config") + "/config.yaml";
+  const testing::ScopedTempDir temp("earlier_config");
+  const std::string path = temp.path() + "/config.yaml";
   std::ofstream(path) << yaml;
 
   EXPECT_FALSE(LoadCairndOptions(path, {}).ok());

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
@@ -24,7 +24,8 @@ std::string Read(const fs::path& p) {
 }
 
 TEST(EarlierRunsTest, AMissingOrEmptyFolderHasNothingToKeep) {
-  const std::string dir = testing::FreshTempDir("earlier_runs_empty");
+  const testing::ScopedTempDir temp("earlier_runs_empty");
+  const std::string dir = temp.path();
   auto r = EarlierRuns::Keep(dir + "/not-there", 3, {});
   ASSERT_TRUE(r.ok()) << r.status().ToString();
   EXPECT_EQ(r->moved_entries, 0);
@@ -38,7 +39,8 @@ TEST(EarlierRunsTest, AMissingOrEmptyFolderHasNothingToKeep) {
 // Two restarts: each run's outputs end up whole in their own numbered folder, and what lives
 // across runs (the item store, a key file in a folder of the output) stays where it is.
 TEST(EarlierRunsTest, EachRestartMovesTheRunBeforeIntoTheNextFolder) {
-  const fs::path dir = testing::FreshTempDir("earlier_runs_move");
+  const testing::ScopedTempDir temp("earlier_runs_move");
+  const fs::path dir = temp.path();
   Touch(dir / "recording-000.mcap", "first");
   Touch(dir / "submaps/rover-000000.submap", "first submap");
   Touch(dir / "exchange/items.log", "store");
@@ -64,7 +66,8 @@ TEST(EarlierRunsTest, EachRestartMovesTheRunBeforeIntoTheNextFolder) {
 
 // Beyond `keep` the oldest folders go, whatever else is in earlier-runs stays; keep 0 keeps none.
 TEST(EarlierRunsTest, TheOldestBeyondKeepAreRemoved) {
-  const fs::path dir = testing::FreshTempDir("earlier_runs_prune");
+  const testing::ScopedTempDir temp("earlier_runs_prune");
+  const fs::path dir = temp.path();
   Touch(dir / "earlier-runs/notes.txt");
   for (int run = 1; run <= 4; ++run) {
     Touch(dir / "summary.json", std::to_string(run));
@@ -89,7 +92,8 @@ TEST(EarlierRunsTest, TheOldestBeyondKeepAreRemoved) {
 }
 
 TEST(EarlierRunsTest, AFileInPlaceOfTheFolderIsAnError) {
-  const fs::path dir = testing::FreshTempDir("earlier_runs_file");
+  const testing::ScopedTempDir temp("earlier_runs_file");
+  const fs::path dir = temp.path();
   Touch(dir / "out", "not a folder");
   const auto r = EarlierRuns::Keep((dir / "out").string(), 3, {});
   ASSERT_FALSE(r.ok());

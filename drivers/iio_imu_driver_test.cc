@@ -11,7 +11,7 @@
 
 #include "drivers/testing/fake_iio_imu.h"
 #include "tests/support/recording_sink.h"
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
@@ -21,7 +21,7 @@ using testing::FakeIioImu;
 class IioImuDriverTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    const std::string root = ::cairn::testing::FreshTempDir("iio");
+    const std::string root = temp_.path();
     options_.sysfs_root = root + "/sys";
     options_.dev_root = root + "/dev";
     options_.rate_hz = 204.8;
@@ -44,6 +44,7 @@ class IioImuDriverTest : public ::testing::Test {
       return std::any_of(sink_.faults.begin(), sink_.faults.end(), [&](const DeviceFault& f) { return f.kind == kind; });
     });
   }
+  const testing::ScopedTempDir temp_{"iio"};
   IioImuOptions options_;
   std::unique_ptr<FakeIioImu> device_;
   testing::RecordingSink sink_;

@@ -24,7 +24,7 @@
 #include "common/angles.h"
 #include "common/monotonic_clock.h"
 #include "tests/support/recording_sink.h"
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
@@ -147,7 +147,7 @@ size_t NmeaPtyCountFaults(testing::RecordingSink& sink, DeviceFaultKind kind) {
 class NmeaGnssDriverTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    link_ = ::cairn::testing::FreshTempDir("nmea") + "/gnss";
+    link_ = temp_.path() + "/gnss";
     auto receiver = NmeaPtyReceiver::Create(link_);
     ASSERT_TRUE(receiver.ok()) << receiver.status().ToString();
     receiver_ = std::move(*receiver);
@@ -165,6 +165,7 @@ class NmeaGnssDriverTest : public ::testing::Test {
     std::lock_guard lock(sink_.mutex);
     return sink_.gnss.size();
   }
+  const testing::ScopedTempDir temp_{"nmea"};
   std::string link_;
   std::unique_ptr<NmeaPtyReceiver> receiver_;
   testing::RecordingSink sink_;

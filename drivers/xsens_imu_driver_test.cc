@@ -14,7 +14,7 @@
 
 #include "drivers/testing/emulated_mti.h"
 #include "tests/support/recording_sink.h"
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
@@ -39,7 +39,7 @@ size_t CountFaults(testing::RecordingSink& sink, DeviceFaultKind kind) {
 class XsensImuDriverTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    link_ = ::cairn::testing::FreshTempDir("xsens") + "/mti";
+    link_ = temp_.path() + "/mti";
     auto device = testing::EmulatedMti::Create(link_);
     ASSERT_TRUE(device.ok()) << device.status().ToString();
     device_ = std::move(*device);
@@ -47,6 +47,7 @@ class XsensImuDriverTest : public ::testing::Test {
   bool WaitForSamples(size_t n) {
     return sink_.WaitFor([&] { return sink_.imu.size() >= n; });
   }
+  const testing::ScopedTempDir temp_{"xsens"};
   std::string link_;
   std::unique_ptr<testing::EmulatedMti> device_;
   testing::RecordingSink sink_;

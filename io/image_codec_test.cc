@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -32,7 +33,8 @@ bool Same(const cv::Mat& a, const cv::Mat& b) {
 }
 
 TEST(ImageCodecTest, LosslessFormatsRoundTripEveryPixel) {
-  const std::string dir = testing::FreshTempDir("image_codec");
+  const testing::ScopedTempDir temp("image_codec");
+  const std::string dir = temp.path();
   const struct {
     const char* name;
     int type;
@@ -51,7 +53,8 @@ TEST(ImageCodecTest, LosslessFormatsRoundTripEveryPixel) {
 }
 
 TEST(ImageCodecTest, GreyConversionsEqualOpenCvs) {
-  const std::string dir = testing::FreshTempDir("image_codec_grey");
+  const testing::ScopedTempDir temp("image_codec_grey");
+  const std::string dir = temp.path();
   const cv::Mat colour = Noise(41, 29, CV_8UC3, 3);
   const cv::Mat wide = Noise(41, 29, CV_16UC1, 4);
   const cv::Mat wide_colour = Noise(41, 29, CV_16UC3, 5);
@@ -126,7 +129,8 @@ bool WriteInterlacedPng(const std::string& path, const cv::Mat& image) {
 }
 
 TEST(ImageCodecTest, InterlacedPngDecodesWhole) {
-  const std::string path = testing::FreshTempDir("image_codec_adam7") + "/adam7.png";
+  const testing::ScopedTempDir temp("image_codec_adam7");
+  const std::string path = temp.path() + "/adam7.png";
   const cv::Mat image = Noise(29, 37, CV_8UC1, 11);
   ASSERT_TRUE(WriteInterlacedPng(path, image));
   const auto back = ImageCodec::Read(path, ImageReadMode::kGray8);
@@ -188,7 +192,8 @@ TEST(ImageCodecTest, DamagedBytesGiveAnErrorNamingTheSource) {
   const std::string text = "hello, not an image";
   EXPECT_FALSE(ImageCodec::Decode({reinterpret_cast<const uint8_t*>(text.data()), text.size()}, ImageReadMode::kGray8, "t").ok());
   EXPECT_EQ(ImageCodec::Read("/nonexistent/x.png", ImageReadMode::kGray8).status().code(), StatusCode::kNotFound);
-  EXPECT_FALSE(ImageCodec::Write(testing::FreshTempDir("image_codec_bad") + "/x.tif", image).ok());
+  const testing::ScopedTempDir temp("image_codec_bad");
+  EXPECT_FALSE(ImageCodec::Write(temp.path() + "/x.tif", image).ok());
   EXPECT_FALSE(ImageCodec::EncodeJpeg(cv::Mat(4, 4, CV_16UC1), 90, &jpeg).ok());
 }
 

@@ -8,13 +8,14 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "mapping/testing/submap_test_util.h"
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
 
 TEST(MapExporterTest, CloudsRoundTripThroughPcdAndPly) {
-  const std::string dir = testing::FreshTempDir("map_exporter");
+  const testing::ScopedTempDir temp("map_exporter");
+  const std::string dir = temp.path();
   const auto submap = testing::SyntheticSubmap(1, 1);
   for (const char* name : {"/c.pcd", "/c.ply"}) {
     ASSERT_TRUE(MapExporter::WriteCloud(submap->points(), dir + name).ok());
@@ -33,7 +34,8 @@ TEST(MapExporterTest, CloudsRoundTripThroughPcdAndPly) {
 }
 
 TEST(MapExporterTest, OctreesAreReadableByOctomap) {
-  const std::string dir = testing::FreshTempDir("map_exporter_tree");
+  const testing::ScopedTempDir temp("map_exporter_tree");
+  const std::string dir = temp.path();
   const auto submap = testing::SyntheticSubmap(1, 1);
   ASSERT_TRUE(MapExporter::WriteOctree(submap->tree(), dir + "/m.bt").ok());
   ASSERT_TRUE(MapExporter::WriteOctree(submap->tree(), dir + "/m.ot").ok());
@@ -54,7 +56,8 @@ TEST(MapExporterTest, OctreesAreReadableByOctomap) {
 }
 
 TEST(MapExporterTest, GridMapFollowsTheMapServerConvention) {
-  const std::string dir = testing::FreshTempDir("map_exporter_grid");
+  const testing::ScopedTempDir temp("map_exporter_grid");
+  const std::string dir = temp.path();
   GridMap g;
   g.resolution = 0.05;
   g.origin_x = -1.0;

@@ -12,6 +12,7 @@
 #include "drivers/replay/euroc_dataset.h"
 #include "sim/rover_can_layout.h"
 #include "sim/world_file.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn::sim {
@@ -74,7 +75,8 @@ uint64_t TreeHash(const std::string& root) {
 TEST(MissionSimulatorTest, WritesEurocFoldersThatTheReplayOpensUnchanged) {
   auto sim = MissionSimulator::Create(MissionWorld(3), ShortMission());
   ASSERT_TRUE(sim.ok()) << sim.status().ToString();
-  const std::string dir = testing::FreshTempDir("sim_euroc");
+  const testing::ScopedTempDir temp("sim_euroc");
+  const std::string dir = temp.path();
   ASSERT_TRUE((*sim)->Write(dir, nullptr).ok());
 
   auto rover = EurocDataset::Open(dir + "/rover");
@@ -101,8 +103,8 @@ TEST(MissionSimulatorTest, WritesEurocFoldersThatTheReplayOpensUnchanged) {
 }
 
 TEST(MissionSimulatorTest, SameSeedGivesIdenticalBytesOtherSeedDoesNot) {
-  const std::string a = testing::FreshTempDir("sim_det_a"), b = testing::FreshTempDir("sim_det_b"),
-                    c = testing::FreshTempDir("sim_det_c");
+  const testing::ScopedTempDir temp_a("sim_det_a"), temp_b("sim_det_b"), temp_c("sim_det_c");
+  const std::string a = temp_a.path(), b = temp_b.path(), c = temp_c.path();
   for (const auto& [dir, seed] : {std::pair{a, 3}, std::pair{b, 3}, std::pair{c, 4}}) {
     auto sim = MissionSimulator::Create(MissionWorld(seed), ShortMission());
     ASSERT_TRUE(sim.ok());

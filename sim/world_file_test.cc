@@ -5,23 +5,25 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn::sim {
 namespace {
 
-std::string Write(const std::string& name, const std::string& text) {
-  const std::string path = testing::FreshTempDir("world") + "/" + name;
+std::string Write(const testing::ScopedTempDir& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir.path() + "/" + name;
   std::ofstream(path) << text;
   return path;
 }
 
 TEST(WorldFileTest, WrittenWorldReadsBackIdentically) {
+  const testing::ScopedTempDir temp("world");
   WorldOptions w;
   w.seed = 99;
   w.size = 44.0;
   w.lander = {1.0, 2.0};
-  auto back = LoadWorldFile(Write("w.yaml", WorldFileText(w)));
+  auto back = LoadWorldFile(Write(temp, "w.yaml", WorldFileText(w)));
   ASSERT_TRUE(back.ok()) << back.status().ToString();
   EXPECT_EQ(back->seed, 99);
   EXPECT_DOUBLE_EQ(back->size, 44.0);
@@ -29,13 +31,14 @@ TEST(WorldFileTest, WrittenWorldReadsBackIdentically) {
 }
 
 TEST(WorldFileTest, InvalidWorldsAreRejectedNamingFileLineAndKey) {
+  const testing::ScopedTempDir temp("world");
   WorldOptions w;
   std::string text = WorldFileText(w);
   const size_t at = text.find("\nsize: ");
   ASSERT_NE(at, std::string::npos) << text;
   text.replace(at, text.find('\n', at + 1) - at, "\nsize: 5");
   text += "craters: 3\n";
-  const std::string path = Write("bad.yaml", text);
+  const std::string path = Write(temp, "bad.yaml", text);
   auto r = LoadWorldFile(path);
   ASSERT_FALSE(r.ok());
   const std::string msg = r.status().message();
@@ -43,11 +46,11 @@ TEST(WorldFileTest, InvalidWorldsAreRejectedNamingFileLineAndKey) {
   EXPECT_NE(msg.find("size"), std::string::npos) << msg;
   EXPECT_NE(msg.find("craters"), std::string::npos) << msg;
 
-  auto missing = LoadWorldFile(Write("m.yaml", "size: 60\n"));
+  auto missing = LoadWorldFile(Write(temp, "m.yaml", "size: 60\n"));
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.status().message().find("seed"), std::string::npos) << missing.status().message();
 
-  auto not_yaml = LoadWorldFile(Write("n.yaml", "size: [60\n"));
+  auto not_yaml = LoadWorldFile(Write(temp, "n.yaml", "size: [60\n"));
   EXPECT_FALSE(not_yaml.ok());
   EXPECT_FALSE(LoadWorldFile("/nonexistent/world.yaml").ok());
 
@@ -55,7 +58,7 @@ TEST(WorldFileTest, InvalidWorldsAreRejectedNamingFileLineAndKey) {
   const size_t l = lander.find("lander: [");
   ASSERT_NE(l, std::string::npos) << lander;
   lander.replace(l, lander.find('\n', l) - l, "lander: [29.5, 0]");
-  auto off = LoadWorldFile(Write("l.yaml", lander));
+  auto off = LoadWorldFile(Write(temp, "l.yaml", lander));
   ASSERT_FALSE(off.ok());
   EXPECT_NE(off.status().message().find("lander"), std::string::npos) << off.status().message();
 }

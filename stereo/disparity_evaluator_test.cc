@@ -1,7 +1,6 @@
 #include "stereo/disparity_evaluator.h"
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <string>
@@ -12,21 +11,17 @@
 
 #include "stereo/pfm_io.h"
 #include "stereo/stereo_image_io.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
 
 const float kInf = std::numeric_limits<float>::infinity();
 
-std::string TempPath(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("cairn_fpga_" + std::to_string(::getpid()) + "_" + name))
-      .string();
-}
-
 TEST(PfmIoTest, RoundTripKeepsValuesRowOrderAndInfinity) {
   FloatImage img{3, 2, {1.5f, 2.25f, kInf, -4.0f, 0.0f, 1e6f}};
-  const std::string path = TempPath("rt.pfm");
+  const testing::ScopedTempDir temp("pfm_rt");
+  const std::string path = temp.path() + "/rt.pfm";
   ASSERT_TRUE(WritePfm(path, img).ok());
   auto back = ReadPfm(path);
   ASSERT_TRUE(back.ok()) << back.status().ToString();
@@ -41,12 +36,12 @@ TEST(PfmIoTest, RoundTripKeepsValuesRowOrderAndInfinity) {
   float first;
   std::memcpy(&first, header.data() + header.size() - 24, 4);
   EXPECT_EQ(first, -4.0f);
-  std::filesystem::remove(path);
 }
 
 TEST(PfmIoTest, ReportsBadFiles) {
-  EXPECT_EQ(ReadPfm(TempPath("missing.pfm")).status().code(), StatusCode::kNotFound);
-  const std::string path = TempPath("bad.pfm");
+  const testing::ScopedTempDir temp("pfm_bad");
+  EXPECT_EQ(ReadPfm(temp.path() + "/missing.pfm").status().code(), StatusCode::kNotFound);
+  const std::string path = temp.path() + "/bad.pfm";
   {
     std::ofstream f(path);
     f << "P6\n2 2\n255\n";
@@ -59,7 +54,6 @@ TEST(PfmIoTest, ReportsBadFiles) {
   EXPECT_EQ(ReadPfm(path).status().code(), StatusCode::kDataLoss);
   EXPECT_FALSE(WritePfm(path, FloatImage{2, 2, {1.0f}}).ok());
   EXPECT_FALSE(WritePfm("/nonexistent-dir/x.pfm", FloatImage{1, 1, {1.0f}}).ok());
-  std::filesystem::remove(path);
 }
 
 TEST(DisparityEvaluatorTest, CountsBadAndMissingPixels) {
@@ -156,7 +150,8 @@ TEST(DisparityEvaluatorTest, DerivedMaskMarksPixelsHiddenBehindNearerOnes) {
 }
 
 TEST(DisparityEvaluatorTest, LoadsScaledPngGroundTruth) {
-  const std::string p8 = TempPath("gt8.png"), p16 = TempPath("gt16.png");
+  const testing::ScopedTempDir temp("disparity_gt");
+  const std::string p8 = temp.path() + "/gt8.png", p16 = temp.path() + "/gt16.png";
   cv::Mat g8(1, 3, CV_8UC1);
   g8.at<uint8_t>(0, 0) = 0;
   g8.at<uint8_t>(0, 1) = 40;
@@ -174,13 +169,12 @@ TEST(DisparityEvaluatorTest, LoadsScaledPngGroundTruth) {
   ASSERT_TRUE(gt.ok());
   EXPECT_FLOAT_EQ(gt->data[0], 30.5f);
   EXPECT_TRUE(std::isinf(gt->data[1]));
-  EXPECT_EQ(LoadGroundTruth(TempPath("none.png"), 1.0).status().code(), StatusCode::kNotFound);
-  std::filesystem::remove(p8);
-  std::filesystem::remove(p16);
+  EXPECT_EQ(LoadGroundTruth(temp.path() + "/none.png", 1.0).status().code(), StatusCode::kNotFound);
 }
 
 TEST(StereoImageIoTest, ReportsUnreadableAndMismatchedPairs) {
-  const std::string a = TempPath("a.png"), b = TempPath("b.png");
+  const testing::ScopedTempDir temp("stereo_pair");
+  const std::string a = temp.path() + "/a.png", b = temp.path() + "/b.png";
   ASSERT_TRUE(cv::imwrite(a, cv::Mat(10, 12, CV_8UC3, cv::Scalar(1, 2, 3))));
   ASSERT_TRUE(cv::imwrite(b, cv::Mat(10, 13, CV_8UC1, cv::Scalar(5))));
   auto ok = LoadGrayPair(a, a);
@@ -189,10 +183,8 @@ TEST(StereoImageIoTest, ReportsUnreadableAndMismatchedPairs) {
   auto mismatch = LoadGrayPair(a, b);
   EXPECT_EQ(mismatch.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(mismatch.status().message().find("13x10"), std::string::npos);
-  EXPECT_EQ(LoadGrayPair(TempPath("nope.png"), a).status().code(), StatusCode::kNotFound);
-  EXPECT_EQ(LoadGrayPair(a, TempPath("nope.png")).status().code(), StatusCode::kNotFound);
-  std::filesystem::remove(a);
-  std::filesystem::remove(b);
+  EXPECT_EQ(LoadGrayPair(temp.path() + "/nope.png", a).status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(LoadGrayPair(a, temp.path() + "/nope.png").status().code(), StatusCode::kNotFound);
 }
 
 }  // namespace

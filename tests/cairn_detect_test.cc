@@ -12,6 +12,7 @@
 #include "detection/testing/rendered_tag.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -23,7 +24,8 @@ testing::ProcessResult Detect(std::vector<std::string> args) {
 }
 
 TEST(CairnDetectTest, ARenderedTagIsWhereItWasDrawn) {
-  const std::string dir = testing::FreshTempDir("cairn_detect");
+  const testing::ScopedTempDir temp("cairn_detect");
+  const std::string dir = temp.path();
   const PinholeRadTan camera{1024, 508, 1080.0, 1080.0, 512.0, 254.0};
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
   truth.translation() = Eigen::Vector3d(0.3, -0.1, 1.8);
@@ -54,7 +56,8 @@ TEST(CairnDetectTest, ARealPhotoHasItsTwelveTags) {
 }
 
 TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
-  const std::string dir = testing::FreshTempDir("cairn_detect_lut");
+  const testing::ScopedTempDir temp("cairn_detect_lut");
+  const std::string dir = temp.path();
   const std::string table = dir + "/rover.lut";
   auto r = Detect({"build-lut", "--camera", "rover", "--out", table, "--distances", "1,4,2", "--angles", "0,40,2",
                    "--samples", "3", "--seed", "5", "--decimate", "1"});
@@ -102,7 +105,8 @@ TEST(CairnDetectTest, BuildLutWritesATableThatCheckLutScoresEveryModelOn) {
 }
 
 TEST(CairnDetectTest, BadInputEndsWithAStatusNamingIt) {
-  const std::string dir = testing::FreshTempDir("cairn_detect_bad");
+  const testing::ScopedTempDir temp("cairn_detect_bad");
+  const std::string dir = temp.path();
   auto r = Detect({dir + "/none.png", "--intrinsics", "1,1,1,1"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("no such image file " + dir + "/none.png"), std::string::npos) << r.output;

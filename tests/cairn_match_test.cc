@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "mapping/testing/rock_field_scene.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -29,7 +31,8 @@ void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
 class CairnMatchTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = testing::FreshTempDir("cairn_match");
+    temp_ = std::make_unique<testing::ScopedTempDir>("cairn_match");
+    dir_ = temp_->path();
     const testing::ScenePair pair = testing::OverlappingSubmaps(7);
     T_a_b_ = pair.T_world_a.inverse() * pair.T_world_b;
     auto a = SubmapCodec::Encode(*pair.a), b = SubmapCodec::Encode(*pair.b);
@@ -38,11 +41,13 @@ class CairnMatchTest : public ::testing::Test {
     WriteBytes(dir_ + "/a.submap", *a);
     WriteBytes(dir_ + "/b.submap", *b);
   }
+  static void TearDownTestSuite() { temp_.reset(); }
   testing::ProcessResult Match(const std::vector<std::string>& args) {
     std::vector<std::string> argv = {Cairn(), "match"};
     argv.insert(argv.end(), args.begin(), args.end());
     return testing::RunProcess(argv);
   }
+  static inline std::unique_ptr<testing::ScopedTempDir> temp_;
   static inline std::string dir_;
   static inline Eigen::Isometry3d T_a_b_;
   static inline std::vector<uint8_t> a_bytes_;

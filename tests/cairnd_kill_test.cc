@@ -23,6 +23,7 @@
 #include "mapping/submap_codec.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -113,7 +114,8 @@ KilledRun CheckOutputs(const fs::path& out) {
 }
 
 TEST(CairndKillTest, KilledAtRandomMomentsLosesNothingFinishedAndRestartsKeepEveryRun) {
-  const fs::path out = testing::FreshTempDir("cairnd_kill");
+  const testing::ScopedTempDir temp("cairnd_kill");
+  const fs::path out = temp.path();
   // Each start of the simulator costs seconds under the sanitizers, so the suite kills 4 times;
   // CAIRN_KILLS=N runs a longer campaign (docs/results.md reports one).
   const char* env = std::getenv("CAIRN_KILLS");

@@ -18,6 +18,7 @@
 #include "drivers/testing/emulated_mti.h"
 #include "drivers/testing/fake_iio_imu.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -31,7 +32,8 @@ std::string ReadFile(const std::string& path) {
 }
 
 TEST(CairndLiveImuTest, TheRoverProfileRunsLiveOnItsXsensImu) {
-  const std::string dir = testing::FreshTempDir("live_imu");
+  const testing::ScopedTempDir temp("live_imu");
+  const std::string dir = temp.path();
   const std::string link = dir + "/mti";
   auto device = testing::EmulatedMti::Create(link);
   ASSERT_TRUE(device.ok()) << device.status().ToString();
@@ -81,7 +83,8 @@ TEST(CairndLiveImuTest, TheRoverProfileRunsLiveOnItsXsensImu) {
 }
 
 TEST(CairndLiveImuTest, TheHexacopterProfileRunsLiveOnItsIioImu) {
-  const std::string dir = testing::FreshTempDir("live_iio");
+  const testing::ScopedTempDir temp("live_iio");
+  const std::string dir = temp.path();
   const std::string sys = dir + "/sys", dev = dir + "/dev";
   auto device = testing::FakeIioImu::Create(sys, dev);
   ASSERT_TRUE(device.ok()) << device.status().ToString();

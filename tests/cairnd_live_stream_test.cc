@@ -15,6 +15,7 @@
 #include "tests/support/js_clients.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -51,7 +52,8 @@ TEST(CairndLiveStreamTest, FoxgloveClientDecodesEveryChannelWhileOthersVanish) {
   const std::string js = testing::InstallJsClients(&why_not);
   if (js.empty()) GTEST_SKIP() << why_not;
   const int port = FreeLoopbackPort();
-  const std::string out = testing::FreshTempDir("live");
+  const testing::ScopedTempDir temp("live");
+  const std::string out = temp.path();
   testing::ProcessResult daemon;
   std::thread runner([&] {
     testing::ProcessOptions po;

@@ -25,6 +25,7 @@
 #include "sim/world_file.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -72,7 +73,8 @@ const StampedPose& Nearest(const Trajectory& t, Timestamp time) {
 }
 
 TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
-  const std::string out = testing::FreshTempDir("cairnd_mapping");
+  const testing::ScopedTempDir temp("cairnd_mapping");
+  const std::string out = temp.path();
   // 0.45 m submaps, so 0.4 m/s over the last 4 s of 6 (the rover stands for 2 s) partitions the
   // drive into several.
   auto args = RoverArgs(out + "/a", 6.0, 0.5);
@@ -209,7 +211,8 @@ TEST(CairndMappingTest, RoverMapsSubmapsOnTheTrueTerrainDeterministically) {
 // through every stage: rendered pairs, SGM both ways, VO, filter, fusion, submaps, composition;
 // it is placed in the world by the trajectory's alignment, as `cairn summary` does.
 TEST(CairndMappingTest, HexacopterMapLiesOnTheTrueSurfaces) {
-  const std::string out = testing::FreshTempDir("cairnd_mapping_hexacopter");
+  const testing::ScopedTempDir temp("cairnd_mapping_hexacopter");
+  const std::string out = temp.path();
   const auto r = RunProcess({Cairnd(), "--config", testing::SourceDir() + "/configs/hexacopter.yaml", "--sim", "--out",
                              out, "--set", "sim.duration=12", "--set", "replay.pacing=fast", "--set",
                              "replay.deterministic=true", "--set", "live.enabled=false", "--set",
@@ -235,7 +238,8 @@ TEST(CairndMappingTest, HexacopterMapLiesOnTheTrueSurfaces) {
 // unchanged host driver computes every dense pair, both passes of the profile's bidirectional
 // matching, and the maps are the CPU kernel's, byte for byte (same SGM in raster_paths mode).
 TEST(CairndMappingTest, SimulatedFpgaBoardMapsExactlyWhatTheCpuMaps) {
-  const std::string out = testing::FreshTempDir("cairnd_mapping_fpga");
+  const testing::ScopedTempDir temp("cairnd_mapping_fpga");
+  const std::string out = temp.path();
   const std::vector<std::string> common = {"--set", "stereo.sgm.num_disparities=32", "--set",
                                            "stereo.every_nth_frame=4", "--set", "stereo.sgm.raster_paths=true"};
   auto cpu = RoverArgs(out + "/cpu", 2.0, 0.25);
@@ -273,7 +277,8 @@ TEST(CairndMappingTest, SimulatedFpgaBoardMapsExactlyWhatTheCpuMaps) {
 // Asked for a board that is not there: one warning, the CPU kernel maps every pair, the run ends
 // normally and the failure is counted.
 TEST(CairndMappingTest, MissingFpgaFallsBackToTheCpuWithOneWarning) {
-  const std::string out = testing::FreshTempDir("cairnd_mapping_nofpga");
+  const testing::ScopedTempDir temp("cairnd_mapping_nofpga");
+  const std::string out = temp.path();
   auto args = RoverArgs(out, 2.0, 0.25);
   args.insert(args.end(), {"--set", "stereo.backend=fpga", "--set", "stereo.device=/nonexistent/uio9", "--set",
                            "stereo.sgm.raster_paths=true", "--set", "stereo.every_nth_frame=4"});
@@ -296,7 +301,8 @@ TEST(CairndMappingTest, MissingFpgaFallsBackToTheCpuWithOneWarning) {
 }
 
 TEST(CairndMappingTest, MappingWithoutDenseStereoIsRefusedNamingTheKeys) {
-  const std::string out = testing::FreshTempDir("cairnd_mapping_bad");
+  const testing::ScopedTempDir temp("cairnd_mapping_bad");
+  const std::string out = temp.path();
   auto args = RoverArgs(out + "/a", 2.0, 0.25);
   args.insert(args.end(), {"--set", "stereo.enabled=false"});
   auto r = RunProcess(args);

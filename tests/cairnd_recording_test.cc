@@ -15,6 +15,7 @@
 #include "io/mcap/mcap_writer.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -98,9 +99,9 @@ class CairndRecordingTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!fs::exists(testing::EurocMicro())) GTEST_SKIP() << "missing " << testing::EurocMicro();
-    dir_ = testing::FreshTempDir("recording");
   }
-  std::string dir_;
+  const testing::ScopedTempDir temp_{"recording"};
+  const std::string dir_ = temp_.path();
 };
 
 TEST_F(CairndRecordingTest, ReplayOfARecordingReproducesTheRunAndTheRecording) {
@@ -251,7 +252,8 @@ TEST_F(CairndRecordingTest, BadRecordingsAreRefusedBeforeAnythingIsWritten) {
 // A simulated rover (wheels, dense stereo, mapping, frame switches made by submap partitioning):
 // the replay of its recording reproduces every estimate, submap and map byte for byte.
 TEST(CairndRecordingSimTest, SimulatedRoverRecordingReplaysToTheSameEstimatesAndMaps) {
-  const std::string dir = testing::FreshTempDir("recording-sim");
+  const testing::ScopedTempDir temp("recording-sim");
+  const std::string dir = temp.path();
   const std::string config = testing::SourceDir() + "/configs/rover.yaml";
   const std::vector<std::string> common = {"--set", "replay.pacing=fast", "--set", "replay.deterministic=true",
                                            "--set", "recording.enabled=true", "--set", "recording.images.format=png",

@@ -12,6 +12,7 @@
 #include "common/sanitizers.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -35,7 +36,6 @@ class CairndReplayTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!fs::exists(testing::EurocMicro())) GTEST_SKIP() << "missing " << testing::EurocMicro();
-    out_ = testing::FreshTempDir("cairnd_out");
   }
   testing::ProcessResult Run(const std::string& dataset, const std::string& out,
                              std::vector<std::string> extra = {}, ProcessOptions po = {}) {
@@ -43,7 +43,8 @@ class CairndReplayTest : public ::testing::Test {
     argv.insert(argv.end(), extra.begin(), extra.end());
     return RunProcess(argv, po);
   }
-  std::string out_;
+  const testing::ScopedTempDir temp_{"cairnd_out"};
+  const std::string out_ = temp_.path();
 };
 
 TEST_F(CairndReplayTest, ReplaysEveryImuSampleAndStereoPairInOrder) {
@@ -86,7 +87,8 @@ TEST_F(CairndReplayTest, RobotProfileReplaysToTheEndWithoutItsCanBus) {
 }
 
 TEST_F(CairndReplayTest, DeterministicReplayWritesIdenticalSummaries) {
-  const std::string second = testing::FreshTempDir("cairnd_out2");
+  const testing::ScopedTempDir temp("cairnd_out2");
+  const std::string second = temp.path();
   ASSERT_EQ(Run(testing::EurocMicro(), out_).exit_code, 0);
   ASSERT_EQ(Run(testing::EurocMicro(), second).exit_code, 0);
   const std::string a = ReadFile(out_ + "/summary.json");
@@ -168,7 +170,8 @@ TEST_F(CairndReplayTest, MalformedDatasetsFailBeforeWritingAnything) {
        }},
   };
   for (const Case& c : cases) {
-    const std::string root = testing::FreshTempDir("broken");
+    const testing::ScopedTempDir temp("broken");
+    const std::string root = temp.path();
     testing::CopyEurocDataset(testing::EurocMicro(), root);
     const std::string culprit = c.damage(root);
     const std::string out = root + "/out";
@@ -180,7 +183,8 @@ TEST_F(CairndReplayTest, MalformedDatasetsFailBeforeWritingAnything) {
 }
 
 TEST_F(CairndReplayTest, CorruptImageMidRunIsAFaultNotAnExit) {
-  const std::string root = testing::FreshTempDir("corrupt");
+  const testing::ScopedTempDir temp("corrupt");
+  const std::string root = temp.path();
   testing::CopyEurocDataset(testing::EurocMicro(), root);
   const std::string img = root + "/mav0/cam1/data/1403715274262142976.png";
   fs::remove(img);

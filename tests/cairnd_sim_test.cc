@@ -13,6 +13,7 @@
 #include "estimation/eval/trajectory.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -34,7 +35,8 @@ std::vector<std::string> SimArgs(const std::string& robot, const std::string& ou
 }
 
 TEST(CairndSimTest, RoverPublishesEveryStreamAndWritesGroundTruth) {
-  const std::string out = testing::FreshTempDir("cairnd_sim");
+  const testing::ScopedTempDir temp("cairnd_sim");
+  const std::string out = temp.path();
   const auto r = RunProcess(SimArgs("rover", out));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue s = JsonValue::ParseFile(out + "/summary.json");
@@ -58,7 +60,8 @@ TEST(CairndSimTest, RoverPublishesEveryStreamAndWritesGroundTruth) {
 // rover (and the lander) for every image; a deterministic replay, where that would depend on
 // thread timing, does without.
 TEST(CairndSimTest, TheGraphPlacesTheCarriersForTheDetectorInLiveRunsOnly) {
-  const std::string out = testing::FreshTempDir("cairnd_sim_predictions");
+  const testing::ScopedTempDir temp("cairnd_sim_predictions");
+  const std::string out = temp.path();
   auto live = SimArgs("rover", out + "/live");
   *std::find(live.begin(), live.end(), "sim.duration=2") = "sim.duration=3";
   *std::find(live.begin(), live.end(), "sim.image_scale=0.25") = "sim.image_scale=0.5";  // the tag's cells
@@ -79,7 +82,8 @@ TEST(CairndSimTest, TheGraphPlacesTheCarriersForTheDetectorInLiveRunsOnly) {
 }
 
 TEST(CairndSimTest, HexacopterHasNoWheels) {
-  const std::string out = testing::FreshTempDir("cairnd_sim_hexa");
+  const testing::ScopedTempDir temp("cairnd_sim_hexa");
+  const std::string out = temp.path();
   const auto r = RunProcess(SimArgs("hexacopter", out));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const JsonValue s = JsonValue::ParseFile(out + "/summary.json");
@@ -88,7 +92,8 @@ TEST(CairndSimTest, HexacopterHasNoWheels) {
 }
 
 TEST(CairndSimTest, WrongSetupsAreRefusedNamingTheKey) {
-  const std::string out = testing::FreshTempDir("cairnd_sim_bad");
+  const testing::ScopedTempDir temp("cairnd_sim_bad");
+  const std::string out = temp.path();
   auto args = SimArgs("rover", out + "/a");
   args.insert(args.end(), {"--set", "sim.robots=hexacopter"});
   auto r = RunProcess(args);
@@ -132,7 +137,8 @@ TEST(CairndSimTest, WrongSetupsAreRefusedNamingTheKey) {
 // Trajectory exports in every format parse back to the same poses, for the filter's chained
 // trajectory and the SLAM graph's global one; a format nobody knows is refused at start-up.
 TEST(CairndSimTest, TrajectoriesInEveryFormatReadBack) {
-  const std::string out = testing::FreshTempDir("cairnd_sim_formats");
+  const testing::ScopedTempDir temp("cairnd_sim_formats");
+  const std::string out = temp.path();
   auto args = SimArgs("rover", out);
   args.insert(args.end(), {"--set", "sim.duration=4", "--set", "sim.image_scale=0.5", "--set", "mapping.enabled=false",
                            "--set", "stereo.enabled=false", "--set", "output.trajectory_formats=tum, euroc,kitti"});

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -23,7 +24,8 @@ namespace {
 
 TEST(CairndSystemdNotifyTest, ReadyStatusWatchdogStopping) {
   if (!std::filesystem::exists(testing::EurocMicro())) GTEST_SKIP() << "missing " << testing::EurocMicro();
-  const std::string dir = testing::FreshTempDir("notify");
+  const testing::ScopedTempDir temp("notify");
+  const std::string dir = temp.path();
   const std::string path = dir + "/notify.sock";
   const int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   ASSERT_GE(fd, 0);

@@ -20,6 +20,7 @@
 #include "tests/support/json_value.h"
 #include "tests/support/loopback_loss.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/tcp_link_proxy.h"
 #include "tests/support/test_data.h"
 
@@ -93,7 +94,8 @@ const JsonValue* RobotEntry(const JsonValue& team, const std::string& name) {
 }
 
 TEST(CairndTeamTest, TwoRobotsHoldEachOthersItemsOnceAndAnIntruderGetsNothing) {
-  const std::string dir = testing::FreshTempDir("cairnd_team");
+  const testing::ScopedTempDir temp("cairnd_team");
+  const std::string dir = temp.path();
   const std::string keys = dir + "/keys";
   const std::string intruder_keys = dir + "/intruder_keys";
   ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
@@ -198,7 +200,8 @@ double ItemCount(const JsonValue& robot) {
 // SIGKILL mid-run, then the same cairnd again on the same disk: the teammate ends up with every
 // item of both runs once, and the second run knows it is the robot's second incarnation.
 TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
-  const std::string dir = testing::FreshTempDir("cairnd_team_kill");
+  const testing::ScopedTempDir temp("cairnd_team_kill");
+  const std::string dir = temp.path();
   const std::string keys = dir + "/keys";
   ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
   const int base = TeamPort(4);
@@ -253,7 +256,8 @@ TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
 // and the robot goes on estimating to the end of its data.
 TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
   if (geteuid() != 0) GTEST_SKIP() << "needs root to mount a small tmpfs";
-  const std::string dir = testing::FreshTempDir("cairnd_team_full");
+  const testing::ScopedTempDir temp("cairnd_team_full");
+  const std::string dir = temp.path();
   const std::string store = dir + "/store";
   fs::create_directories(store);
   if (RunProcess({"/usr/bin/mount", "-t", "tmpfs", "-o", "size=8k", "tmpfs", store}).exit_code != 0) {
@@ -353,7 +357,8 @@ TEST(CairndTeamTest, FaultsAllInOneRunLoseNothingAndTheGraphsAgreeAfterHealing) 
   }
   testing::LoopbackLoss loss(proxy_ports, 30);
   if (!loss.why_not().empty()) GTEST_SKIP() << loss.why_not();
-  const std::string dir = testing::FreshTempDir("cairnd_team_faults");
+  const testing::ScopedTempDir temp("cairnd_team_faults");
+  const std::string dir = temp.path();
   const std::string keys = dir + "/keys";
   const std::vector<Member> team = {{"rover", "a", "rover", base}, {"hexacopter", "b", "hexacopter", base + 1},
                                     {"rover2", "c", "rover", base + 2}};

@@ -3,12 +3,15 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -29,8 +32,9 @@ class CairndVoTest : public ::testing::Test {
   void SetUp() override {
     if (!fs::exists(testing::EurocMicro())) GTEST_SKIP() << "missing " << testing::EurocMicro();
   }
+  // The output folder lives as long as the test.
   std::string RunCairnd(const std::string& name) {
-    const std::string out = testing::FreshTempDir(name);
+    const std::string out = outs_.emplace_back(std::make_unique<testing::ScopedTempDir>(name))->path();
     const auto r = RunProcess({testing::BinaryDir() + "/daemon/cairnd", "--config",
                                testing::SourceDir() + "/configs/euroc.yaml", "--replay", testing::EurocMicro(),
                                "--out", out});
@@ -44,6 +48,7 @@ class CairndVoTest : public ::testing::Test {
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return JsonValue::Parse(r.output);
   }
+  std::vector<std::unique_ptr<testing::ScopedTempDir>> outs_;
 };
 
 TEST_F(CairndVoTest, EurocExcerptAtRestStaysPut) {
@@ -81,7 +86,8 @@ TEST_F(CairndVoTest, EurocExcerptAtRestStaysPut) {
 }
 
 TEST_F(CairndVoTest, EvalRejectsBadAndMismatchedFiles) {
-  const std::string dir = testing::FreshTempDir("cairn_eval_bad");
+  const testing::ScopedTempDir temp("cairn_eval_bad");
+  const std::string dir = temp.path();
   std::ofstream(dir + "/bad.tum") << "1.0 0 0 0 0 0 0 1\nnot a pose\n";
   std::ofstream(dir + "/other_time.tum") << "5.0 0 0 0 0 0 0 1\n6.0 1 0 0 0 0 0 1\n";
   const std::string gt = testing::EurocMicro() + "/mav0/state_groundtruth_estimate0/data.csv";

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/support/process_runner.h"
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -25,10 +26,9 @@ std::string Read(const std::string& p) {
 
 const char kAnalyze[] = "/usr/bin/systemd-analyze";
 
-// Writes both units to a fresh folder with ExecStart pointed at this build's cairnd; returns
-// their paths (the template as the instance cairnd@rover.service).
-std::vector<std::string> WriteUnits() {
-  const std::string dir = testing::FreshTempDir("units");
+// Writes both units to `dir` with ExecStart pointed at this build's cairnd; returns their paths
+// (the template as the instance cairnd@rover.service).
+std::vector<std::string> WriteUnits(const std::string& dir) {
   const std::string cairnd = testing::BinaryDir() + "/daemon/cairnd";
   std::vector<std::string> paths;
   for (const std::string unit : {"cairnd.service", "cairnd@.service"}) {
@@ -56,7 +56,8 @@ std::vector<std::string> WriteUnits() {
 
 TEST(SystemdUnitsTest, UnitsVerify) {
   if (!fs::exists(kAnalyze)) GTEST_SKIP() << "missing " << kAnalyze;
-  const std::vector<std::string> units = WriteUnits();
+  const testing::ScopedTempDir temp("units");
+  const std::vector<std::string> units = WriteUnits(temp.path());
   ASSERT_EQ(units.size(), 2u);
   const auto r = testing::RunProcess({kAnalyze, "verify", "--man=no", units[0], units[1]});
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -68,7 +69,8 @@ TEST(SystemdUnitsTest, UnitsVerify) {
 // systemd's "OK", while the daemon keeps what the real-time thread and the devices need.
 TEST(SystemdUnitsTest, SecurityExposureIsAtMostTwo) {
   if (!fs::exists(kAnalyze)) GTEST_SKIP() << "missing " << kAnalyze;
-  for (const std::string& unit : WriteUnits()) {
+  const testing::ScopedTempDir temp("units");
+  for (const std::string& unit : WriteUnits(temp.path())) {
     SCOPED_TRACE(unit);
     const auto r = testing::RunProcess({kAnalyze, "security", "--offline=true", "--no-pager", unit});
     const std::string marker = "Overall exposure level for ";

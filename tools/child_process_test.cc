@@ -3,21 +3,16 @@
 #include <signal.h>
 
 #include <chrono>
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
 
+#include "tests/support/scoped_temp_dir.h"
+
 namespace cairn::tools {
 namespace {
-
-std::string TempLog(const char* name) {
-  const std::filesystem::path p = std::filesystem::temp_directory_path() / name;
-  std::filesystem::remove(p);
-  return p.string();
-}
 
 std::string Read(const std::string& path) {
   std::ifstream in(path);
@@ -27,7 +22,8 @@ std::string Read(const std::string& path) {
 }
 
 TEST(ChildProcessTest, RunsFromPathAndLogsBothStreams) {
-  const std::string log = TempLog("child_process_test_streams.log");
+  const cairn::testing::ScopedTempDir temp("child_process_streams");
+  const std::string log = temp.path() + "/child.log";
   ChildProcess p;
   ASSERT_TRUE(p.Start({"sh", "-c", "echo out; echo err >&2; exit 3"}, log).ok());
   EXPECT_EQ(p.Wait(), 3);
@@ -37,8 +33,9 @@ TEST(ChildProcessTest, RunsFromPathAndLogsBothStreams) {
 }
 
 TEST(ChildProcessTest, SignalEndsItWithTheSignalNumber) {
+  const cairn::testing::ScopedTempDir temp("child_process_signal");
   ChildProcess p;
-  ASSERT_TRUE(p.Start({"sleep", "30"}, TempLog("child_process_test_signal.log")).ok());
+  ASSERT_TRUE(p.Start({"sleep", "30"}, temp.path() + "/child.log").ok());
   EXPECT_TRUE(p.Running());
   p.Signal(SIGTERM);
   EXPECT_EQ(p.Wait(), 128 + SIGTERM);
@@ -47,18 +44,20 @@ TEST(ChildProcessTest, SignalEndsItWithTheSignalNumber) {
 TEST(ChildProcessTest, MissingProgramIsAnErrorNamingIt) {
   EXPECT_FALSE(ProgramAvailable("cairn-no-such-program"));
   EXPECT_TRUE(ProgramAvailable("sh"));
+  const cairn::testing::ScopedTempDir temp("child_process_missing");
   ChildProcess p;
-  const Status s = p.Start({"cairn-no-such-program"}, TempLog("child_process_test_missing.log"));
+  const Status s = p.Start({"cairn-no-such-program"}, temp.path() + "/child.log");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("cairn-no-such-program"), std::string::npos);
   EXPECT_EQ(p.Wait(), -1);
 }
 
 TEST(ChildProcessTest, DestructionKillsARunningChild) {
+  const cairn::testing::ScopedTempDir temp("child_process_kill");
   pid_t pid = -1;
   {
     ChildProcess p;
-    ASSERT_TRUE(p.Start({"sleep", "30"}, TempLog("child_process_test_kill.log")).ok());
+    ASSERT_TRUE(p.Start({"sleep", "30"}, temp.path() + "/child.log").ok());
     pid = p.pid();
   }
   EXPECT_NE(kill(pid, 0), 0);  // reaped: the pid no longer names a process of ours

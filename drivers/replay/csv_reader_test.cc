@@ -5,17 +5,20 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/scoped_temp_dir.h"
+
 namespace cairn {
 namespace {
 
-std::string WriteTemp(const std::string& name, const std::string& text) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
+std::string WriteTemp(const testing::ScopedTempDir& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir.path() + "/" + name;
   std::ofstream(path, std::ios::binary) << text;
   return path;
 }
 
 TEST(CsvReaderTest, SkipsCommentsBlankLinesAndCarriageReturns) {
-  const std::string p = WriteTemp("cairn_csv_ok.csv", "#t,a\r\n1, 2\r\n\n3,4\n");
+  const testing::ScopedTempDir temp("csv_ok");
+  const std::string p = WriteTemp(temp, "ok.csv", "#t,a\r\n1, 2\r\n\n3,4\n");
   auto rows = CsvReader::ReadAll(p, 2);
   ASSERT_TRUE(rows.ok()) << rows.status().ToString();
   ASSERT_EQ(rows->size(), 2u);
@@ -24,7 +27,8 @@ TEST(CsvReaderTest, SkipsCommentsBlankLinesAndCarriageReturns) {
 }
 
 TEST(CsvReaderTest, TruncatedLastLineNamesFileAndLine) {
-  const std::string p = WriteTemp("cairn_csv_trunc.csv", "1,2,3\n4,5");
+  const testing::ScopedTempDir temp("csv_trunc");
+  const std::string p = WriteTemp(temp, "trunc.csv", "1,2,3\n4,5");
   auto rows = CsvReader::ReadAll(p, 3);
   ASSERT_FALSE(rows.ok());
   EXPECT_EQ(rows.status().code(), StatusCode::kDataLoss);
@@ -33,7 +37,8 @@ TEST(CsvReaderTest, TruncatedLastLineNamesFileAndLine) {
 }
 
 TEST(CsvReaderTest, NonNumericAndNonFiniteFieldsAreErrors) {
-  const std::string p = WriteTemp("cairn_csv_bad.csv", "12x,1.5\n7,nan\n");
+  const testing::ScopedTempDir temp("csv_bad");
+  const std::string p = WriteTemp(temp, "bad.csv", "12x,1.5\n7,nan\n");
   auto rows = CsvReader::ReadAll(p, 2);
   ASSERT_TRUE(rows.ok());
   EXPECT_FALSE(CsvReader::Int(p, (*rows)[0], 0).ok());

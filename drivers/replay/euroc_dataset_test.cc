@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/scoped_temp_dir.h"
 #include "tests/support/test_data.h"
 
 namespace cairn {
@@ -13,7 +14,6 @@ namespace {
 namespace fs = std::filesystem;
 using testing::CopyEurocDataset;
 using testing::EurocMicro;
-using testing::FreshTempDir;
 
 TEST(EurocDatasetTest, IndexesTheMicroExcerpt) {
   CAIRN_REQUIRE_PATH(EurocMicro());
@@ -43,10 +43,10 @@ class BrokenEurocTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!fs::exists(EurocMicro())) GTEST_SKIP() << "missing " << EurocMicro();
-    root_ = FreshTempDir("euroc");
     CopyEurocDataset(EurocMicro(), root_);
   }
-  std::string root_;
+  const testing::ScopedTempDir temp_{"euroc"};
+  const std::string root_ = temp_.path();
 };
 
 TEST_F(BrokenEurocTest, MissingImageNamesTheFile) {
@@ -86,7 +86,8 @@ TEST_F(BrokenEurocTest, NonOrthonormalExtrinsicsAreRejected) {
 }
 
 TEST(EurocDatasetOpenTest, FolderWithoutMav0IsNotADataset) {
-  const std::string dir = FreshTempDir("empty");
+  const testing::ScopedTempDir temp("euroc_empty");
+  const std::string dir = temp.path();
   auto ds = EurocDataset::Open(dir);
   ASSERT_FALSE(ds.ok());
   EXPECT_NE(ds.status().message().find("no mav0/"), std::string::npos);

@@ -7,14 +7,15 @@
 #include <gtest/gtest.h>
 
 #include "estimation/math/so3.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string Temp(const std::string& name, const std::string& text) {
-  const std::string p = (fs::temp_directory_path() / ("cairn_traj_" + name)).string();
+std::string Temp(const testing::ScopedTempDir& dir, const std::string& name, const std::string& text) {
+  const std::string p = dir.path() + "/" + name;
   std::ofstream(p) << text;
   return p;
 }
@@ -33,11 +34,12 @@ Trajectory Spiral() {
 }
 
 TEST(TrajectoryTest, EveryFormatRoundTrips) {
+  const testing::ScopedTempDir temp("trajectory_rt");
   const Trajectory t = Spiral();
   for (auto [format, ext] : {std::pair{TrajectoryFormat::kTum, "tum"}, std::pair{TrajectoryFormat::kEurocCsv, "csv"},
                              std::pair{TrajectoryFormat::kKitti, "kitti"}}) {
-    const std::string path = Temp(std::string("rt.") + ext, TrajectoryIo::Format(t, format));
-    const std::string times = Temp("rt.times", TrajectoryIo::KittiTimes(t));
+    const std::string path = Temp(temp, std::string("rt.") + ext, TrajectoryIo::Format(t, format));
+    const std::string times = Temp(temp, "rt.times", TrajectoryIo::KittiTimes(t));
     EXPECT_EQ(*TrajectoryIo::FormatFromPath(path), format);
     auto back = TrajectoryIo::Read(path, format, format == TrajectoryFormat::kKitti ? times : "");
     ASSERT_TRUE(back.ok()) << back.status().ToString();
@@ -54,19 +56,20 @@ TEST(TrajectoryTest, EveryFormatRoundTrips) {
 }
 
 TEST(TrajectoryTest, MalformedLinesNameFileAndLine) {
-  const std::string tum = Temp("bad.tum", "# header\n1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 1\n");
+  const testing::ScopedTempDir temp("trajectory_bad");
+  const std::string tum = Temp(temp, "bad.tum", "# header\n1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 1\n");
   auto a = TrajectoryIo::Read(tum, TrajectoryFormat::kTum);
   ASSERT_FALSE(a.ok());
   EXPECT_NE(a.status().message().find(tum + ":3"), std::string::npos) << a.status().message();
-  const std::string q = Temp("badq.tum", "1.0 0 0 0 0 0 0 2\n");
+  const std::string q = Temp(temp, "badq.tum", "1.0 0 0 0 0 0 0 2\n");
   EXPECT_NE(TrajectoryIo::Read(q, TrajectoryFormat::kTum).status().message().find("norm"), std::string::npos);
-  const std::string csv = Temp("bad.csv", "12x,0,0,0,1,0,0,0\n");
+  const std::string csv = Temp(temp, "bad.csv", "12x,0,0,0,1,0,0,0\n");
   EXPECT_FALSE(TrajectoryIo::Read(csv, TrajectoryFormat::kEurocCsv).ok());
-  const std::string kitti = Temp("bad.kitti", "2 0 0 0 0 1 0 0 0 0 1 0\n");
+  const std::string kitti = Temp(temp, "bad.kitti", "2 0 0 0 0 1 0 0 0 0 1 0\n");
   EXPECT_NE(TrajectoryIo::Read(kitti, TrajectoryFormat::kKitti).status().message().find("orthonormal"),
             std::string::npos);
-  const std::string ok_kitti = Temp("ok.kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
-  const std::string short_times = Temp("short.times", "0.5\n");
+  const std::string ok_kitti = Temp(temp, "ok.kitti", "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n");
+  const std::string short_times = Temp(temp, "short.times", "0.5\n");
   EXPECT_FALSE(TrajectoryIo::Read(ok_kitti, TrajectoryFormat::kKitti, short_times).ok());
   EXPECT_FALSE(TrajectoryIo::FormatFromPath("x.bin").ok());
   EXPECT_FALSE(TrajectoryIo::FormatFromName("bag").ok());

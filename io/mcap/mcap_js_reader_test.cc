@@ -11,7 +11,7 @@
 #include "tests/support/js_clients.h"
 #include "tests/support/json_value.h"
 #include "tests/support/process_runner.h"
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
@@ -43,7 +43,8 @@ TEST(McapJsReaderTest, FoxgloveReaderReadsEveryCompressionAndACrashedFile) {
   std::string why_not;
   const std::string js = testing::InstallJsClients(&why_not);
   if (js.empty()) GTEST_SKIP() << why_not;
-  const std::string dir = testing::FreshTempDir("mcap_js");
+  const testing::ScopedTempDir temp("mcap_js");
+  const std::string dir = temp.path();
   std::vector<std::string> files;
   for (auto [name, c] : {std::pair{"none", Compression::kNone}, std::pair{"zstd", Compression::kZstd},
                          std::pair{"lz4", Compression::kLz4}}) {

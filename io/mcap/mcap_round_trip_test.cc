@@ -7,7 +7,7 @@
 
 #include "io/mcap/mcap_reader.h"
 #include "io/mcap/mcap_writer.h"
-#include "tests/support/test_data.h"
+#include "tests/support/scoped_temp_dir.h"
 
 namespace cairn {
 namespace {
@@ -57,7 +57,8 @@ std::vector<Sent> WriteFile(const std::string& path, Compression compression, bo
 class McapRoundTripTest : public ::testing::TestWithParam<Compression> {};
 
 TEST_P(McapRoundTripTest, MessagesSummaryAndIndexesReadBack) {
-  const std::string path = testing::FreshTempDir("mcap") + "/rt.mcap";
+  const testing::ScopedTempDir temp("mcap");
+  const std::string path = temp.path() + "/rt.mcap";
   const auto sent = WriteFile(path, GetParam());
   McapReader reader(path);
   size_t i = 0;
@@ -108,7 +109,8 @@ INSTANTIATE_TEST_SUITE_P(Compressions, McapRoundTripTest,
                                            Compression::kLz4));
 
 TEST(McapTruncationTest, CutMidChunkReadsEveryWholeChunk) {
-  const std::string dir = testing::FreshTempDir("mcap_cut");
+  const testing::ScopedTempDir temp("mcap_cut");
+  const std::string dir = temp.path();
   const std::string path = dir + "/cut.mcap";
   const auto sent = WriteFile(path, Compression::kZstd);
   McapReader full(path);
@@ -131,7 +133,8 @@ TEST(McapTruncationTest, CutMidChunkReadsEveryWholeChunk) {
 }
 
 TEST(McapTruncationTest, UnclosedWriterLeavesAReadableFile) {
-  const std::string path = testing::FreshTempDir("mcap_open") + "/open.mcap";
+  const testing::ScopedTempDir temp("mcap_open");
+  const std::string path = temp.path() + "/open.mcap";
   McapWriter w;
   WriteFile(path, Compression::kLz4, /*close=*/false, &w);
   // Simulates SIGKILL: the file stays as written so far; only the open chunk is missing.
@@ -145,7 +148,8 @@ TEST(McapTruncationTest, UnclosedWriterLeavesAReadableFile) {
 }
 
 TEST(McapCorruptionTest, FlippedByteInAChunkIsACrcError) {
-  const std::string path = testing::FreshTempDir("mcap_bad") + "/bad.mcap";
+  const testing::ScopedTempDir temp("mcap_bad");
+  const std::string path = temp.path() + "/bad.mcap";
   WriteFile(path, Compression::kNone);
   auto summary = McapReader(path).ReadSummary();
   ASSERT_TRUE(summary.ok());
@@ -165,7 +169,8 @@ TEST(McapCorruptionTest, FlippedByteInAChunkIsACrcError) {
 }
 
 TEST(McapCorruptionTest, NotAnMcapFile) {
-  const std::string path = testing::FreshTempDir("mcap_not") + "/x.mcap";
+  const testing::ScopedTempDir temp("mcap_not");
+  const std::string path = temp.path() + "/x.mcap";
   std::ofstream(path) << "hello, this is not MCAP";
   auto scan = McapReader(path).Scan(nullptr);
   ASSERT_FALSE(scan.ok());
@@ -173,7 +178,8 @@ TEST(McapCorruptionTest, NotAnMcapFile) {
 }
 
 TEST(McapWriterTest, EmptyFileIsValidAndChannelsNeedKnownSchemas) {
-  const std::string path = testing::FreshTempDir("mcap_empty") + "/e.mcap";
+  const testing::ScopedTempDir temp("mcap_empty");
+  const std::string path = temp.path() + "/e.mcap";
   McapWriter w;
   ASSERT_TRUE(w.Open(path, {}).ok());
   EXPECT_FALSE(w.AddChannel("/x", "protobuf", 5).ok());

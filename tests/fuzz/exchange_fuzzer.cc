@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -17,6 +18,12 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::string dir = "/tmp/cairn_fuzz_exchange_" + std::to_string(getpid());
+  // Gone when the fuzzer exits normally; a crash leaves the store of the input that caused it.
+  static const bool removed_at_exit = std::atexit([] {
+                                        std::error_code ec;
+                                        std::filesystem::remove_all(dir, ec);
+                                      }) == 0;
+  (void)removed_at_exit;
   std::filesystem::remove_all(dir);
   cairn::ItemStoreOptions store_options;
   store_options.fsync = false;

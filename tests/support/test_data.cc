@@ -1,21 +1,8 @@
 #include "tests/support/test_data.h"
 
-#include <unistd.h>
-
-#include <atomic>
-
 namespace cairn::testing {
 
 namespace fs = std::filesystem;
-
-std::string FreshTempDir(const std::string& tag) {
-  static std::atomic<int> counter{0};
-  const fs::path p = fs::temp_directory_path() /
-                     ("cairn_" + tag + "_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
 
 void CopyEurocDataset(const std::string& from, const std::string& to) {
   for (const auto& e : fs::recursive_directory_iterator(from)) {

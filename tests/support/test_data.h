@@ -1,5 +1,6 @@
 #pragma once
-// Locating the shared real data sets from tests, and making writable, damageable copies of them.
+// Locating the shared real data sets from tests, and making writable, damageable copies of them
+// (into a ScopedTempDir, tests/support/scoped_temp_dir.h).
 
 #include <cstdlib>
 #include <filesystem>
@@ -23,9 +24,6 @@ inline std::string BinaryDir() { return CAIRN_TEST_BINARY_DIR; }
 #endif
 
 inline std::string EurocMicro() { return DataDir() + "/euroc-v1_01-micro"; }
-
-// A fresh empty folder under the system temp directory, unique per test.
-std::string FreshTempDir(const std::string& tag);
 
 // Copies an EuRoC folder's text files (CSV, YAML) and links its images, so a test can break one
 // file without copying 200 images or touching the shared data.
