@@ -158,6 +158,10 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.EndObject();
     j.Field("map_points", m.map_points).Field("map_voxels", m.map_voxels);
     j.Field("submaps_placed_by_graph", m.submaps_placed_by_graph);
+    j.Key("lines").BeginObject();
+    j.Field("segments", m.line_segments).Field("triangulated", m.line_sightings);
+    j.Field("joined", m.mapper.line_sightings).Field("in_submaps", m.submap_lines);
+    j.EndObject();
     j.Key("first_errors").BeginArray();
     for (const auto& e : m.errors) j.String(e);
     j.EndArray();

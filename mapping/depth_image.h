@@ -10,6 +10,7 @@
 #include "common/status.h"
 #include "common/timestamp.h"
 #include "hal/calibration.h"
+#include "mapping/line_sighting.h"
 
 namespace cairn {
 
@@ -22,6 +23,7 @@ struct DepthImage {
   int height = 0;
   std::vector<float> depth;
   std::vector<uint8_t> intensity;  // optional gray values of the left image (empty: none)
+  std::vector<LineSighting> lines;  // optional straight edges seen in it, camera frame
 
   float at(int u, int v) const { return depth[static_cast<size_t>(v) * static_cast<size_t>(width) + static_cast<size_t>(u)]; }
   // Checks sizes and values (no negative depths); names what is wrong.

@@ -44,6 +44,7 @@ LocalMapper::LocalMapper(const MappingOptions& options, const StereoCamera& came
       classifier_(options.obstacles, camera, projector_.error_model(), projector_.range()),
       integrator_(options.submap.octree_resolution, MaxDistance(camera, projector_.range())),
       planes_(options.planes, projector_.error_model()),
+      lines_(options.lines.fusion),
       rolling_(options.rolling_map),
       partitioner_(options.partition, requester),
       open_(std::make_unique<OpenSubmap>(options.submap, robot_, 0)) {}
@@ -51,10 +52,12 @@ LocalMapper::LocalMapper(const MappingOptions& options, const StereoCamera& came
 std::shared_ptr<const Submap> LocalMapper::FinishAndStart(uint64_t new_frame_id) {
   std::shared_ptr<const Submap> done;
   if (open_->metadata().images > 0) {
-    done = open_->Finish(options_.planes.enabled ? &planes_ : nullptr);
+    done = open_->Finish(options_.planes.enabled ? &planes_ : nullptr,
+                         options_.lines.enabled ? lines_.Lines() : std::vector<SubmapLine>{});
     ++stats_.submaps_finished;
   }
   open_->Restart(new_frame_id);
+  lines_.Reset();
   return done;
 }
 
@@ -95,6 +98,11 @@ Status LocalMapper::Process(const DepthImage& image, const MappingPose& pose) {
         static_cast<int64_t>(DropInaccurate(static_cast<float>(options_.depth.max_map_error), &points_));
   }
   open_->Integrate(points_, &integrator_);
+  if (options_.lines.enabled) {
+    const Eigen::Isometry3d T_local_cam = pose.T_local_body * projector_.camera().T_body_cam;
+    for (const LineSighting& s : image.lines)
+      stats_.line_sightings += lines_.Add(s.Transformed(T_local_cam)) ? 1 : 0;
+  }
   partitioner_.Update(pose.time, pose.frame_id, body, pose.position_covariance);
   ++stats_.images;
   stats_.obstacle_points += obstacles_.obstacle_points;

@@ -16,6 +16,7 @@
 #include "mapping/occupancy_integrator.h"
 #include "mapping/rolling_obstacle_map.h"
 #include "mapping/submap.h"
+#include "mapping/submap_line_fuser.h"
 #include "mapping/submap_partitioner.h"
 
 namespace cairn {
@@ -36,6 +37,7 @@ struct LocalMapperStats {
   int64_t obstacle_points = 0;
   int64_t submaps_finished = 0;
   int64_t unannounced_frame_changes = 0;  // poses in a new frame without OnFrameSwitch
+  int64_t line_sightings = 0;             // edges seen in images that joined or started a submap edge
 };
 
 class LocalMapper {
@@ -69,6 +71,7 @@ class LocalMapper {
   ObstacleClassifier classifier_;
   OccupancyIntegrator integrator_;
   PlaneExtractor planes_;
+  SubmapLineFuser lines_;
   RollingObstacleMap rolling_;
   SubmapPartitioner partitioner_;
   std::unique_ptr<OpenSubmap> open_;

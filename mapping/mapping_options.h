@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/options_visitor.h"
+#include "mapping/line_options.h"
 
 namespace cairn {
 
@@ -196,6 +197,7 @@ struct MappingOptions {
   RollingMapOptions rolling_map;
   SubmapOptions submap;
   PlaneOptions planes;
+  LineOptions lines;
   PartitionOptions partition;
   CompositionOptions composition;
 
@@ -206,6 +208,7 @@ struct MappingOptions {
     v.Section("rolling_map", rolling_map);
     v.Section("submap", submap);
     v.Section("planes", planes);
+    v.Section("lines", lines);
     v.Section("partition", partition);
     v.Section("composition", composition);
   }

@@ -20,6 +20,10 @@ submap: {cloud_resolution: 0.05, octree_resolution: 0.1, log_odds_hit: 0.85, log
          wire_intensity_bits: 7}
 planes: {enabled: true, cell_size: 0.25, min_cell_points: 12, tolerance_sigmas: 3.0, min_tolerance: 0.02,
          max_normal_angle: 10.0, min_area: 1.0, max_planes: 32}
+lines: {enabled: true,
+        detection: {min_length_px: 60, max_segments: 200, min_gradient: 5, angle_tolerance_deg: 22.5, max_deviation_px: 1, max_gap_px: 8, max_gap_fraction: 0.25},
+        triangulation: {pixel_error_px: 0.5, endpoint_sigma_px: 1, sample_spacing_px: 2, side_offset_px: 2, side_rows: 3, side_row_spacing_px: 1.5, disparity_slope_prior: 0.1, disparity_correlation_px: 5, inlier_sigmas: 3, min_inlier_fraction: 0.7, min_valid_fraction: 0.5, min_support: 12, min_disparity_px: 1, max_depth_sigma: 0.15},
+        fusion: {max_angle: 15, gate_chi2: 23.5, max_gap: 0.3, min_sightings: 2, min_length: 0.3, max_lines: 256, max_segments: 32}}
 partition: {max_position_sigma: 0.2, max_distance: 7.0, retry_interval: 1.0}
 composition: {cloud_resolution: 0.05, rebuild_translation: 0.02, rebuild_rotation_deg: 0.2}
 )";
@@ -30,6 +34,8 @@ TEST(MappingOptionsTest, LoadsFromYamlAndNamesBadKeys) {
   ASSERT_TRUE(reader.Read(o).ok()) << reader.Read(o).ToString();
   EXPECT_DOUBLE_EQ(o.partition.max_position_sigma, 0.2);
   EXPECT_DOUBLE_EQ(o.planes.cell_size, 0.25);
+  EXPECT_TRUE(o.lines.enabled);
+  EXPECT_DOUBLE_EQ(o.lines.fusion.gate_chi2, 23.5);
   EXPECT_EQ(o.obstacles.window_cells, 4);
   EXPECT_DOUBLE_EQ(o.obstacles.max_step, 0.1);
   EXPECT_DOUBLE_EQ(o.obstacles.step_tie_tolerance, 0.01);

@@ -41,7 +41,7 @@ int64_t Submap::obstacle_points() const {
 
 size_t Submap::memory_bytes() const {
   return sizeof(*this) + HeapBytes(points_) + tree_bytes_ + HeapBytes(structure_.viewpoints) +
-         HeapBytes(structure_.planes);
+         HeapBytes(structure_.planes) + HeapBytes(structure_.lines);
 }
 
 OpenSubmap::OpenSubmap(const SubmapOptions& options, std::string robot, uint64_t id)
@@ -79,12 +79,13 @@ void OpenSubmap::Restart(uint64_t id) {
   metadata_ = std::move(fresh);
 }
 
-std::shared_ptr<const Submap> OpenSubmap::Finish(PlaneExtractor* planes) {
+std::shared_ptr<const Submap> OpenSubmap::Finish(PlaneExtractor* planes, std::vector<SubmapLine> lines) {
   tree_->updateInnerOccupancy();
   tree_->prune();
   SubmapStructure structure;
   std::vector<CloudPoint> points = cloud_.Points();
   if (planes != nullptr) structure.planes = planes->Extract(points, viewpoints_);
+  structure.lines = std::move(lines);
   structure.viewpoints = std::move(viewpoints_);
   viewpoints_.clear();
   auto submap =

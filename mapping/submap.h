@@ -15,6 +15,7 @@
 #include "mapping/mapping_options.h"
 #include "mapping/occupancy_integrator.h"
 #include "mapping/plane_extractor.h"
+#include "mapping/submap_line.h"
 #include "mapping/submap_plane.h"
 #include "mapping/voxel_cloud.h"
 
@@ -30,10 +31,11 @@ struct SubmapMetadata {
 };
 
 // What a submap holds beyond its cloud and tree: where its cameras were (one viewpoint per
-// OpenSubmap::kViewpointSpacing of travel, the submap frame) and its planar faces.
+// OpenSubmap::kViewpointSpacing of travel, the submap frame), its planar faces and its straight edges.
 struct SubmapStructure {
   std::vector<Eigen::Vector3f> viewpoints;
   std::vector<SubmapPlane> planes;
+  std::vector<SubmapLine> lines;
 };
 
 class Submap {
@@ -70,8 +72,8 @@ class OpenSubmap {
   static constexpr float kViewpointSpacing = 0.25f;
 
   // Inner nodes updated and the tree pruned; the open submap is left empty. With `planes`, the
-  // planar faces are extracted.
-  std::shared_ptr<const Submap> Finish(PlaneExtractor* planes = nullptr);
+  // planar faces are extracted; `lines` are its straight edges.
+  std::shared_ptr<const Submap> Finish(PlaneExtractor* planes = nullptr, std::vector<SubmapLine> lines = {});
   // Starts over, empty, as submap `id`. The voxel table keeps its capacity: a new one per submap
   // (megabytes, freed while the finished submap's small blocks filled the heap around it) left
   // the heap fragmented, growing by about 5 MB per submap.

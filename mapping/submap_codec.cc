@@ -31,8 +31,58 @@ float F32(ByteReader& r) { return std::bit_cast<float>(r.U32()); }
 // Caps of the structure stream, far above what a submap holds, against counts that lie.
 constexpr uint32_t kMaxViewpoints = 1u << 20;
 constexpr uint32_t kMaxPlanes = 1u << 16;
+constexpr uint32_t kMaxLines = 1u << 16;
+constexpr uint64_t kPlaneBytes = 19 * 4;  // 18 floats and the point count
+constexpr uint64_t kLineBytes = 33 * 4;   // 32 floats and the sighting count
 
-void WriteStructure(const SubmapStructure& s, ByteWriter& w) {
+void WriteLines(const std::vector<SubmapLine>& lines, ByteWriter& w) {
+  w.U32(static_cast<uint32_t>(lines.size()));
+  for (const SubmapLine& l : lines) {
+    for (int a = 0; a < 3; ++a) F32(w, l.anchor[a]);
+    for (int a = 0; a < 3; ++a) F32(w, l.moment[a]);
+    for (int a = 0; a < 3; ++a) F32(w, l.direction[a]);
+    F32(w, l.t_min);
+    F32(w, l.t_max);
+    for (int i = 0; i < 6; ++i) {
+      for (int j = i; j < 6; ++j) F32(w, l.covariance(i, j));
+    }
+    w.U32(l.sightings);
+  }
+}
+
+Status ReadLines(ByteReader& r, std::vector<SubmapLine>* lines) {
+  const uint32_t count = r.U32();
+  if (r.failed() || count > kMaxLines || uint64_t{count} * kLineBytes != r.remaining())
+    return DataLossError("submap line count " + std::to_string(count) + " does not match the data");
+  lines->resize(count);
+  for (uint32_t k = 0; k < count; ++k) {
+    SubmapLine& l = (*lines)[k];
+    for (int a = 0; a < 3; ++a) l.anchor[a] = F32(r);
+    for (int a = 0; a < 3; ++a) l.moment[a] = F32(r);
+    for (int a = 0; a < 3; ++a) l.direction[a] = F32(r);
+    l.t_min = F32(r);
+    l.t_max = F32(r);
+    for (int i = 0; i < 6; ++i) {
+      for (int j = i; j < 6; ++j) l.covariance(i, j) = l.covariance(j, i) = F32(r);
+    }
+    l.sightings = r.U32();
+    const std::string at = "submap line " + std::to_string(k) + ": ";
+    if (!l.anchor.allFinite() || !l.moment.allFinite() || !l.direction.allFinite())
+      return DataLossError(at + "anchor, moment or direction is not finite");
+    if (std::abs(l.direction.norm() - 1.0f) > 1e-3f)
+      return DataLossError(at + "direction is not a unit vector");
+    // The moment is perpendicular to the direction (the Pluecker constraint), to float precision.
+    if (std::abs(l.moment.dot(l.direction)) > 1e-3f * std::max(1.0f, l.moment.norm()))
+      return DataLossError(at + "moment is not perpendicular to the direction");
+    if (!(l.t_min <= l.t_max) || !std::isfinite(l.t_min) || !std::isfinite(l.t_max))
+      return DataLossError(at + "ends are invalid");
+    if (!l.covariance.allFinite() || (l.covariance.diagonal().array() < 0.0f).any())
+      return DataLossError(at + "covariance is not finite or has a negative variance");
+  }
+  return Status::Ok();
+}
+
+void WriteStructure(const SubmapStructure& s, uint16_t version, ByteWriter& w) {
   w.U32(static_cast<uint32_t>(s.viewpoints.size()));
   for (const Eigen::Vector3f& v : s.viewpoints) {
     for (int a = 0; a < 3; ++a) F32(w, v[a]);
@@ -50,9 +100,10 @@ void WriteStructure(const SubmapStructure& s, ByteWriter& w) {
     F32(w, p.area);
     w.U32(p.points);
   }
+  if (version >= 5) WriteLines(s.lines, w);
 }
 
-Status ReadStructure(ByteReader& r, SubmapStructure* s) {
+Status ReadStructure(ByteReader& r, uint16_t version, SubmapStructure* s) {
   const uint32_t views = r.U32();
   if (r.failed() || views > kMaxViewpoints || uint64_t{views} * 12 > r.remaining())
     return DataLossError("submap viewpoint count " + std::to_string(views) + " exceeds the data");
@@ -63,8 +114,10 @@ Status ReadStructure(ByteReader& r, SubmapStructure* s) {
       return DataLossError("submap viewpoint " + std::to_string(i) + " is not finite");
   }
   const uint32_t planes = r.U32();
-  constexpr uint64_t kPlaneBytes = 19 * 4;  // 18 floats and the point count
-  if (r.failed() || planes > kMaxPlanes || uint64_t{planes} * kPlaneBytes != r.remaining())
+  // Version 5 has the lines (at least their count) after the planes.
+  const uint64_t plane_bytes = uint64_t{planes} * kPlaneBytes;
+  if (r.failed() || planes > kMaxPlanes ||
+      (version >= 5 ? plane_bytes + 4 > r.remaining() : plane_bytes != r.remaining()))
     return DataLossError("submap plane count " + std::to_string(planes) + " does not match the data");
   s->planes.resize(planes);
   for (uint32_t k = 0; k < planes; ++k) {
@@ -89,6 +142,7 @@ Status ReadStructure(ByteReader& r, SubmapStructure* s) {
     if (!(p.min.array() <= p.max.array()).all() || !(p.area >= 0.0f && std::isfinite(p.area)))
       return DataLossError(at + "extent or area is invalid");
   }
+  if (version >= 5) return ReadLines(r, &s->lines);
   return Status::Ok();
 }
 
@@ -338,7 +392,7 @@ Expected<std::vector<uint8_t>> SubmapCodec::Encode(const Submap& submap, Compres
   w.Bytes(std::span(reinterpret_cast<const uint8_t*>(tree.data()), tree.size()));
   if (version >= 4) {
     cuts.push_back(w.size());
-    WriteStructure(submap.structure(), w);
+    WriteStructure(submap.structure(), version, w);
   }
 
   cuts.push_back(w.size());
@@ -526,7 +580,7 @@ Expected<std::shared_ptr<const Submap>> SubmapCodec::Decode(std::span<const uint
     return DataLossError("submap octree size does not match the data");
   const auto tree_bytes = r.Take(tree_size);
   SubmapStructure structure;
-  if (version >= 4) CAIRN_RETURN_IF_ERROR(ReadStructure(r, &structure));
+  if (version >= 4) CAIRN_RETURN_IF_ERROR(ReadStructure(r, version, &structure));
   CAIRN_RETURN_IF_ERROR(ValidateOctreeBinary(tree_bytes).WithContext("submap octree"));
   auto tree = MakeOccupancyTree(m.options);
   if (!tree_bytes.empty()) {

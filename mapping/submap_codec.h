@@ -6,8 +6,9 @@
 // bits, and the occupancy tree in OctoMap's binary format (maximum-likelihood free/occupied leaves,
 // pruned); each stream compressed on its own (zstd or LZ4), all protected by CRC-32s of the
 // compressed and the uncompressed bytes. Version 4 adds a last stream: the viewpoints and the
-// planar faces (float32, exact). Versions 4 and 3 (no such stream) decode, and either is encoded on
-// request, for teammates still on version 3; version 2 (4 offset bits, 8 intensity bits, one
+// planar faces (float32, exact); version 5 adds the straight edges (anchored Pluecker lines) to it.
+// Versions 5, 4 and 3 (no such stream) decode, and each is encoded on request, for teammates still
+// on an older one; version 2 (4 offset bits, 8 intensity bits, one
 // compressed block) and version 1 (raw channels) are not read any more.
 //
 // Lossy by design: points move by at most resolution / 2^(bits+1) per axis, intensity and colour
@@ -30,7 +31,7 @@ namespace cairn {
 
 class SubmapCodec {
  public:
-  static constexpr uint16_t kVersion = 4;
+  static constexpr uint16_t kVersion = 5;
   static constexpr uint16_t kOldestVersion = 3;
 
   static Expected<std::vector<uint8_t>> Encode(const Submap& submap,

@@ -242,6 +242,18 @@ SubmapStructure SomeStructure() {
   wall.offset = 3.25f;
   wall.points = 900;
   st.planes = {floor, wall};
+  SubmapLine edge;
+  edge.anchor = {0.3f, -0.1f, 0.52f};
+  edge.direction = Eigen::Vector3f(0.6f, 0.0f, 0.8f);
+  edge.moment = Eigen::Vector3f(1.0f, 2.0f, 0.5f).cross(edge.direction);
+  edge.t_min = -0.4f;
+  edge.t_max = 1.7f;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j)
+      edge.covariance(i, j) = (i == j ? 1e-4f : 1e-6f) * static_cast<float>(1 + i + j);
+  }
+  edge.sightings = 12;
+  st.lines = {edge};
   return st;
 }
 
@@ -266,7 +278,50 @@ TEST(SubmapCodecTest, ViewpointsAndPlanesRoundTripExactly) {
     EXPECT_EQ(b.planes[k].area, a.planes[k].area);
     EXPECT_EQ(b.planes[k].points, a.planes[k].points);
   }
+  ASSERT_EQ(b.lines.size(), 1u);
+  EXPECT_EQ(b.lines[0].anchor, a.lines[0].anchor);
+  EXPECT_EQ(b.lines[0].moment, a.lines[0].moment);
+  EXPECT_EQ(b.lines[0].direction, a.lines[0].direction);
+  EXPECT_EQ(b.lines[0].t_min, a.lines[0].t_min);
+  EXPECT_EQ(b.lines[0].t_max, a.lines[0].t_max);
+  EXPECT_EQ(b.lines[0].covariance, a.lines[0].covariance);
+  EXPECT_EQ(b.lines[0].sightings, a.lines[0].sightings);
   EXPECT_EQ((*back)->points().size(), submap->points().size());
+}
+
+TEST(SubmapCodecTest, VersionFourIsStillWrittenAndReadWithoutTheLines) {
+  const auto submap = WithStructure(*testing::SyntheticSubmap(4), SomeStructure());
+  auto v4 = SubmapCodec::Encode(*submap, Compression::kZstd, 4);
+  ASSERT_TRUE(v4.ok()) << v4.status().ToString();
+  EXPECT_EQ((*v4)[8], 4);
+  auto back = SubmapCodec::Decode(*v4);
+  ASSERT_TRUE(back.ok()) << back.status().ToString();
+  EXPECT_EQ((*back)->structure().planes.size(), 2u);
+  EXPECT_EQ((*back)->structure().viewpoints.size(), 3u);
+  EXPECT_TRUE((*back)->structure().lines.empty());
+  auto v5 = SubmapCodec::Encode(*submap);
+  ASSERT_TRUE(v5.ok());
+  EXPECT_EQ((*v5)[8], 5);
+  EXPECT_GT(v5->size(), v4->size());
+}
+
+TEST(SubmapCodecTest, RejectsALineThatIsNotOne) {
+  SubmapStructure st = SomeStructure();
+  st.lines[0].moment += 0.1f * st.lines[0].direction;
+  auto bytes = SubmapCodec::Encode(*WithStructure(*testing::SyntheticSubmap(5), st));
+  ASSERT_TRUE(bytes.ok());
+  auto r = SubmapCodec::Decode(*bytes);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), StatusCode::kDataLoss);
+  EXPECT_NE(r.status().message().find("submap line 0: moment is not perpendicular to the direction"),
+            std::string::npos)
+      << r.status().message();
+  st = SomeStructure();
+  std::swap(st.lines[0].t_min, st.lines[0].t_max);
+  bytes = SubmapCodec::Encode(*WithStructure(*testing::SyntheticSubmap(5), st));
+  ASSERT_TRUE(bytes.ok());
+  EXPECT_NE(SubmapCodec::Decode(*bytes).status().message().find("submap line 0: ends are invalid"),
+            std::string::npos);
 }
 
 TEST(SubmapCodecTest, VersionThreeIsStillWrittenAndReadWithoutTheStructure) {

@@ -139,7 +139,7 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
 constexpr const char* kBenchMatchUsage =
     "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
     "                         [--no-photometric] [--no-grey-search] [--no-grey-refinement]\n"
-    "                         [--no-planes] [--dof 4|6]\n"
+    "                         [--no-planes] [--no-lines] [--dof 4|6]\n"
     "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
     "  --wire-bits: first send every submap through the wire format at these bit counts\n"
     "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
@@ -147,6 +147,7 @@ constexpr const char* kBenchMatchUsage =
     "  --no-grey-search: hypotheses from the descriptors only (no search of the grey levels from above)\n"
     "  --no-grey-refinement: the ICP's x, y and yaw as they are (not moved to the grey levels' best)\n"
     "  --no-planes: no hypotheses from pairs of the submaps' planar faces\n"
+    "  --no-lines: no hypotheses from pairs of the submaps' straight edges\n"
     "  --dof 6: the matcher's variant without gravity; a match must then also be level within 0.5 deg\n";
 
 int RunBenchMatch(const CommandArgs& args) {
@@ -175,6 +176,8 @@ int RunBenchMatch(const CommandArgs& args) {
       matcher_options.grey_refinement = false;
     } else if (a == "--no-planes") {
       matcher_options.planes.enabled = false;
+    } else if (a == "--no-lines") {
+      matcher_options.lines.enabled = false;
     } else if (a == "--dof" && i + 1 < args.args.size() &&
                (args.args[i + 1] == std::string("4") || args.args[i + 1] == std::string("6"))) {
       frame = args.args[++i] == std::string("6") ? ShotFrame::kFull : ShotFrame::kGravity;
@@ -363,6 +366,7 @@ int RunMatch(const CommandArgs& args) {
   j.Field("icp_rms", r.icp_rms).Field("icp_iterations", r.icp_iterations);
   j.Field("photometric_rejected", r.photometric_rejected).Field("grey_pairs", r.photometric.pairs);
   j.Field("searched", r.searched).Field("plane_hypotheses", r.plane_hypotheses);
+  j.Field("line_hypotheses", r.line_hypotheses);
   j.Field("grey_correlation", r.photometric.ncc);  // null where the grey levels could not judge
   j.EndObject();
   j.Key("time_ms").BeginObject();
@@ -372,6 +376,7 @@ int RunMatch(const CommandArgs& args) {
       .Field("icp", r.times.icp_ms)
       .Field("search", r.times.search_ms)
       .Field("planes", r.times.planes_ms)
+      .Field("lines", r.times.lines_ms)
       .Field("match_total", r.times.total_ms);
   j.EndObject();
   j.EndObject();

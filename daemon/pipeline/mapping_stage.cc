@@ -68,6 +68,10 @@ MappingStage::MappingStage(const MappingSetup& setup, std::unique_ptr<StereoBack
     bidirectional_ = std::make_unique<BidirectionalRasterMatcher>(
         *matcher_, static_cast<int>(setup_.stereo.bidirectional_max_diff), setup_.stereo.sgm.pixel_error_px);
   }
+  if (setup_.mapping.map.lines.enabled) {
+    lines_ = std::make_unique<KeyframeLineExtractor>(setup_.mapping.map.lines,
+                                                     MappingCamera(setup_.camera, setup_.T_body_cam));
+  }
   if (setup_.mapping.write_submaps && !setup_.output_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(setup_.output_dir + "/submaps", ec);
@@ -116,6 +120,18 @@ void MappingStage::OnPair(const RectifiedPair& pair) {
   depth->intensity.resize(static_cast<size_t>(in.width) * static_cast<size_t>(in.height));
   for (int y = 0; y < in.height; ++y) {
     std::copy_n(pair.left.row(y), in.width, depth->intensity.data() + static_cast<size_t>(y) * in.width);
+  }
+  // The edges now, while this pair's disparity is at hand; they wait for the pose with the image.
+  if (lines_ != nullptr) {
+    const Timestamp line_start = clock.Now();
+    KeyframeLineExtractor::Stats stats;
+    if (lines_->Extract(in.left, in.width, in.height, in.stride, disparity_, &depth->lines, &stats)) {
+      line_time_.Record(clock.Now() - line_start);
+      report_.line_segments += static_cast<uint64_t>(stats.detected);
+      report_.line_sightings += static_cast<uint64_t>(stats.triangulated);
+    } else {
+      Error("lines at " + std::to_string(pair.time.seconds()) + " s: the disparity does not fit the image");
+    }
   }
   // A pose comes within a few frames; images that wait longer than a second's worth of frames are
   // the oldest and the least useful.
@@ -204,6 +220,7 @@ void MappingStage::Map(const DepthImage& image, const FrameEstimate& e) {
 void MappingStage::Keep(std::shared_ptr<const Submap> submap) {
   if (submap == nullptr) return;
   ++report_.submaps_finished;
+  report_.submap_lines += submap->structure().lines.size();
   // On disk first: whatever the graph, the exchange or the recording learn of a submap survives a
   // crash right after.
   WriteSubmapFile(*submap);

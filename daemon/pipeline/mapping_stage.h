@@ -21,10 +21,11 @@
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/estimation_stage.h"
 #include "daemon/pipeline/latency_histogram.h"
-#include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/mapping_stage_options.h"
+#include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
 #include "fpga/stereo_backend_switch.h"
+#include "mapping/keyframe_line_extractor.h"
 #include "mapping/local_mapper.h"
 #include "mapping/map_composer.h"
 #include "stereo/bidirectional_raster_matcher.h"
@@ -72,6 +73,9 @@ struct MappingStageReport {
   uint64_t submaps_memory_bytes = 0;  // clouds and octrees of every submap composed at the end
   uint64_t composer_bytes = 0;  // the composer's cache and tables at the end (MapComposer::memory_bytes)
   uint64_t team_submaps = 0;            // teammates' submaps composed into the map
+  uint64_t line_segments = 0;           // straight edges detected in the left images (mapping.lines)
+  uint64_t line_sightings = 0;          // of them, triangulated with the disparity
+  uint64_t submap_lines = 0;            // edges kept in the finished submaps
   LocalMapperStats mapper;
   std::vector<std::string> errors;   // the first few, verbatim
 };
@@ -105,6 +109,7 @@ class MappingStage {
   const std::map<uint64_t, Timestamp>& origin_times() const { return origin_times_; }
   const LatencyHistogram& match_time() const { return match_time_; }
   const LatencyHistogram& map_time() const { return map_time_; }
+  const LatencyHistogram& line_time() const { return line_time_; }
   size_t waiting_images() const { return waiting_.size(); }
 
  private:
@@ -126,6 +131,7 @@ class MappingStage {
   // Both passes over matcher_ when stereo.bidirectional is on; null otherwise.
   std::unique_ptr<BidirectionalRasterMatcher> bidirectional_;
   StereoMatcherOutput disparity_;
+  std::unique_ptr<KeyframeLineExtractor> lines_;  // with mapping.lines
   LocalMapper mapper_;
   MapComposer composer_;
   uint64_t frame_id_ = 0;  // the mapper's current local frame
@@ -134,7 +140,7 @@ class MappingStage {
   std::deque<DepthImage> waiting_;
   std::deque<FrameEstimate> estimates_;
   std::deque<FrameSwitchEvent> switches_;
-  LatencyHistogram match_time_, map_time_;
+  LatencyHistogram match_time_, map_time_, line_time_;
   MappingStageReport report_;
   TelemetryStage* telemetry_ = nullptr;
 };

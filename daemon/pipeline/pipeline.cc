@@ -797,6 +797,7 @@ std::vector<StageTimingReport> Pipeline::stage_timing_reports() const {
   if (mapping_) {
     out.push_back(r("dense_stereo", mapping_->match_time()));
     out.push_back(r("mapping", mapping_->map_time()));
+    out.push_back(r("lines", mapping_->line_time()));
   }
   if (graph_) out.push_back(r("graph_update", graph_->update_time()));
   if (detection_) {

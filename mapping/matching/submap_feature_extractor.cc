@@ -39,6 +39,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   }
 
   f.planes = submap.structure().planes;
+  f.lines = submap.structure().lines;
   const auto describe_start = std::chrono::steady_clock::now();
   GravityShotDescriptor descriptor(submap.points(), options_.descriptor, frame_);
   f.described = descriptor.ComputeAll(f.keypoints.points);

@@ -39,6 +39,7 @@ struct SubmapFeatures {
   // xy extent of the finite obstacle points (submap frame); empty when there are none.
   Eigen::AlignedBox2d obstacle_box_xy;
   std::vector<SubmapPlane> planes;  // the submap's planar faces (empty when unsuitable)
+  std::vector<SubmapLine> lines;    // and its straight edges (the same)
   double keypoint_ms = 0.0;    // keypoints, known-space filter and suitability
   double descriptor_ms = 0.0;  // descriptors (zero for an unsuitable submap)
 

@@ -417,6 +417,21 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     }
   }
 
+  // Then pairings of straight edges (man-made things too small or noisy for planes).
+  if (!six && options_.lines.enabled && !a.lines.empty() && !b.lines.empty()) {
+    stage = Clock::now();
+    const std::vector<LineHypothesis> paired = LineHypotheses(options_.lines).Find(a.lines, b.lines);
+    r.times.lines_ms = MillisecondsSince(stage);
+    for (const LineHypothesis& candidate : paired) {
+      ++r.line_hypotheses;
+      if (Alternative(candidate.T_a_b, "edge pairing",
+                      Format("straight edges paired (%d agree, shortest %.1f m)", candidate.edges_agreeing,
+                             candidate.length),
+                      options_.min_match_ncc))
+        return finish(MatchStatus::kMatched, r.reason);
+    }
+  }
+
   // Where neither gave a hypothesis that held, the grey levels seen from above are
   // searched for one (4-DoF only: the search turns about gravity).
   if (!six && options_.grey_search.enabled) {

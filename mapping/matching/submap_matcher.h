@@ -31,6 +31,7 @@
 #include "mapping/matching/four_dof_transform.h"
 #include "mapping/matching/grey_level_search.h"
 #include "mapping/matching/hough_voting.h"
+#include "mapping/matching/line_hypotheses.h"
 #include "mapping/matching/photometric_agreement.h"
 #include "mapping/matching/plane_hypotheses.h"
 #include "mapping/matching/submap_feature_extractor.h"
@@ -47,6 +48,8 @@ struct SubmapMatcherOptions {
   // Hypotheses from the submaps' planar faces where the descriptors' fail, before the search
   // (4-DoF only).
   PlaneHypothesisOptions planes;
+  // Then from their straight edges (4-DoF only).
+  LineHypothesisOptions lines;
   // Hypotheses and the refined match must lie within gate_sigmas standard deviations of the
   // relative estimate in each of x, y, z and yaw (thesis: 2, on x, y, z). The floors stand for the
   // matcher's own error, so a relative estimate known better than the matcher cannot veto it.
@@ -95,6 +98,7 @@ struct SubmapMatcherOptions {
     v.Section("icp", icp);
     v.Section("grey_search", grey_search);
     v.Section("planes", planes);
+    v.Section("lines", lines);
     v.Number("gate_sigmas", gate_sigmas, 0.5, 100.0, "");
     v.Number("gate_floor_translation", gate_floor_translation, 0.0, 100.0, "m");
     v.Number("gate_floor_yaw", gate_floor_yaw, 0.0, 3.2, "rad");
@@ -135,6 +139,7 @@ struct MatchStageTimes {
   double icp_ms = 0.0;     // every refinement, the searched candidates' too
   double search_ms = 0.0;  // the grey-level search, when it ran
   double planes_ms = 0.0;  // pairing the planar faces, when it ran
+  double lines_ms = 0.0;   // pairing the straight edges, when it ran
   double total_ms = 0.0;
 };
 
@@ -153,6 +158,7 @@ struct SubmapMatchResult {
   size_t refined = 0;          // hypotheses handed to the ICP
   size_t searched = 0;         // candidates of the grey-level search (not in the counts above)
   size_t plane_hypotheses = 0;  // from the planar faces (not in the counts above either)
+  size_t line_hypotheses = 0;   // from the straight edges (nor here)
   int dof = 4;                 // 6: the variant without gravity
   Eigen::Isometry3d T_a_b_full = Eigen::Isometry3d::Identity();  // = T_a_b in 4-DoF
   double tilt = 0.0;           // rad; angle between A's z and B's z under T_a_b_full
