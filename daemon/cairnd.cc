@@ -524,6 +524,10 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const 
   if (const SubmapMatchingStage* matching = pipeline.matching(); matching != nullptr && options_.matching.write_csv) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/matches.csv", matching->FormatCsv()));
   }
+  if (const PlaneLandmarkStage* planes = pipeline.plane_landmarks();
+      planes != nullptr && pipeline.graph() != nullptr && options_.matching.plane_landmarks.write_csv) {
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/planes.csv", planes->Csv(*pipeline.graph())));
+  }
   if (pipeline.detection() != nullptr && pipeline.graph() != nullptr && options_.detection.write_csv) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/detections.csv", FormatDetectionsCsv(pipeline.graph()->detections())));
   }

@@ -212,6 +212,23 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.EndArray();
     j.EndObject();
   }
+  if (const PlaneLandmarkStage* planes = p.plane_landmarks()) {
+    // Planar faces as landmarks: what was compared, paired and what the graph holds.
+    const PlaneLandmarkReport r = planes->report();
+    j.Key("plane_landmarks").BeginObject();
+    j.Field("submaps", r.submaps).Field("faces", r.faces).Field("pairs", r.pairs);
+    j.Field("associations", r.associations).Field("observations", r.observations);
+    j.Field("team_observations", r.team_observations).Field("refused", r.refused).Field("waiting", r.waiting);
+    if (const GraphStage* graph = p.graph()) {
+      const GraphStageReport g = graph->report();
+      j.Field("graph_landmarks", g.plane_landmarks).Field("graph_observations", g.plane_observations);
+      j.Field("graph_pending", g.plane_observations_pending);
+    }
+    j.Key("first_errors").BeginArray();
+    for (const auto& e : r.errors) j.String(e);
+    j.EndArray();
+    j.EndObject();
+  }
   if (const RobotDetectionStage* detection = p.detection()) {
     // Tag sightings (thesis 6.2): what the detector saw, and what the graph made of them.
     const RobotDetectionReport& r = detection->report();

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <span>
 
 #include "common/json_value.h"
 #include "daemon/simulated_map_accuracy.h"
@@ -17,6 +18,7 @@
 #include "estimation/eval/trajectory.h"
 #include "estimation/eval/trajectory_evaluator.h"
 #include "tools/commands.h"
+#include "tools/plane_landmark_score.h"
 
 namespace cairn::tools {
 namespace {
@@ -179,6 +181,27 @@ void PrintAgreement(const std::vector<TeamView>& views) {
 constexpr const char* kSummaryUsage =
     "usage: cairn summary OUT_DIR [OUT_DIR ...]\n";
 
+namespace {
+
+// Plane landmarks against the simulator's truth, over every robot's observations.
+void PrintPlaneLandmarks(std::span<char* const> dirs) {
+  bool any = false;
+  for (const char* d : dirs) any = any || std::filesystem::exists(std::string(d) + "/planes.csv");
+  if (!any) return;
+  const auto score = ScorePlaneLandmarks(std::vector<std::string>(dirs.begin(), dirs.end()));
+  if (!score.ok()) {
+    std::printf("plane landmarks: %s\n", score.status().message().c_str());
+    return;
+  }
+  const PlaneLandmarkScore& s = *score;
+  std::printf(
+      "plane landmarks: %d landmarks, %d observations; of %d scored against the truth, %d wrong (%d of them "
+      "still inside the gate at the end); right ones within %.1f deg and %.3f m of their first face\n",
+      s.landmarks, s.observations, s.scored, s.wrong, s.wrong_surviving, s.max_angle_deg, s.max_distance);
+}
+
+}  // namespace
+
 int RunSummary(const CommandArgs& args) {
   if (WantsHelp(args)) return PrintUsage(kSummaryUsage);
   if (args.args.empty()) {
@@ -269,6 +292,7 @@ int RunSummary(const CommandArgs& args) {
     }
   }
   PrintAgreement(views);
+  PrintPlaneLandmarks(args.args);
   return rc;
 }
 

@@ -194,6 +194,14 @@ void CommsStage::PublishGnssFix(const TeamGnssFix& fix) {
   Push(std::move(o));
 }
 
+void CommsStage::PublishPlaneObservations(const std::vector<TeamPlaneObservation>& observations) {
+  if (observations.empty()) return;  // teammates refuse an empty item
+  Outgoing o;
+  o.kind = Outgoing::Kind::kPlaneObservations;
+  o.planes = observations;
+  Push(std::move(o));
+}
+
 void CommsStage::FinishOwnLog() {
   Outgoing o;
   o.kind = Outgoing::Kind::kFinish;
@@ -222,18 +230,24 @@ void CommsStage::Publish(TeamItemKind kind, std::string payload) {
   report_.sent_items_by_kind[TeamItemKindName(static_cast<uint16_t>(kind))]++;
 }
 
-void CommsStage::SplitFrames(TeamMatch* m) const {
+void CommsStage::SplitFrame(const std::string& robot, uint64_t* frame, uint32_t* incarnation) const {
   // Graph frame indices back into (run, frame) as the wire names them.
-  const auto split = [this](const std::string& robot, uint64_t* frame, uint32_t* incarnation) {
-    if (robot == setup_.robot && RunOfIndex(*frame) == kCurrentRun) {
-      *incarnation = report_.incarnation;
-      return;
-    }
-    *incarnation = IncarnationOfRun(RunOfIndex(*frame));
-    *frame = LocalIndex(*frame);
-  };
-  split(m->robot_a, &m->frame_a, &m->incarnation_a);
-  split(m->robot_b, &m->frame_b, &m->incarnation_b);
+  if (robot == setup_.robot && RunOfIndex(*frame) == kCurrentRun) {
+    *incarnation = report_.incarnation;
+    return;
+  }
+  *incarnation = IncarnationOfRun(RunOfIndex(*frame));
+  *frame = LocalIndex(*frame);
+}
+
+void CommsStage::SplitFrames(TeamMatch* m) const {
+  SplitFrame(m->robot_a, &m->frame_a, &m->incarnation_a);
+  SplitFrame(m->robot_b, &m->frame_b, &m->incarnation_b);
+}
+
+void CommsStage::SplitFrames(TeamPlaneObservation* o) const {
+  SplitFrame(o->observer, &o->frame, &o->observer_incarnation);
+  SplitFrame(o->creator, &o->creator_frame, &o->creator_incarnation);
 }
 
 void CommsStage::FlushPoses() {
@@ -283,6 +297,15 @@ void CommsStage::PublishOwn(Timestamp now, bool flush) {
         break;
       case Outgoing::Kind::kGnssFix:
         Publish(TeamItemKind::kGnssFix, TeamItemCodec::GnssFix(report_.incarnation, o.gnss));
+        break;
+      case Outgoing::Kind::kPlaneObservations:
+        if (o.planes.size() > TeamItemCodec::kMaxPlaneObservations) {
+          Error(std::to_string(o.planes.size()) +
+                " plane observations of one submap, more than teammates take");
+          break;
+        }
+        for (TeamPlaneObservation& p : o.planes) SplitFrames(&p);
+        Publish(TeamItemKind::kPlaneObservations, TeamItemCodec::PlaneObservations(o.planes));
         break;
       case Outgoing::Kind::kFinish:
         FlushPoses();

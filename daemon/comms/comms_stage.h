@@ -84,6 +84,7 @@ class CommsStage final : public TeamLink {
   void PublishAttempt(const TeamMatch& pair, bool matched, const std::string& outcome) override;
   void PublishDetection(const TeamDetection& detection) override;
   void PublishGnssFix(const TeamGnssFix& fix) override;
+  void PublishPlaneObservations(const std::vector<TeamPlaneObservation>& observations) override;
   bool NextInput(TeamInput* input) override;
   void SetNotify(std::function<void()> notify) override;
   void FinishOwnLog() override;
@@ -101,6 +102,7 @@ class CommsStage final : public TeamLink {
       kAttempt,
       kDetection,
       kGnssFix,
+      kPlaneObservations,
       kFinish
     };
     Kind kind = Kind::kEstimate;
@@ -112,6 +114,7 @@ class CommsStage final : public TeamLink {
     std::string outcome;
     TeamDetection detection;
     TeamGnssFix gnss;
+    std::vector<TeamPlaneObservation> planes;
   };
 
   explicit CommsStage(const CommsSetup& setup);
@@ -120,7 +123,9 @@ class CommsStage final : public TeamLink {
   void Push(Outgoing o);
   void PublishOwn(Timestamp now, bool flush);
   void FlushPoses();
+  void SplitFrame(const std::string& robot, uint64_t* frame, uint32_t* incarnation) const;
   void SplitFrames(TeamMatch* match) const;
+  void SplitFrames(TeamPlaneObservation* observation) const;
   void Publish(TeamItemKind kind, std::string payload);
   void OnItem(const StoreItem& item);
   void Error(const std::string& what);

@@ -77,6 +77,8 @@ const char* TeamItemKindName(uint16_t kind) {
     case TeamItemKind::kDetection: return "detection";
     case TeamItemKind::kGnssFix:
       return "gnss_fix";
+    case TeamItemKind::kPlaneObservations:
+      return "plane_observations";
   }
   return "unknown";
 }
@@ -191,6 +193,32 @@ std::string TeamItemCodec::GnssFix(uint32_t incarnation, const TeamGnssFix& g) {
   m.set_antenna_x(g.antenna.x());
   m.set_antenna_y(g.antenna.y());
   m.set_antenna_z(g.antenna.z());
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::PlaneObservations(const std::vector<TeamPlaneObservation>& observations) {
+  exchange::PlaneObservationsItem m;
+  for (const TeamPlaneObservation& o : observations) {
+    auto* p = m.add_observations();
+    p->set_observer(o.observer);
+    p->set_observer_incarnation(o.observer_incarnation);
+    p->set_frame(o.frame);
+    p->set_creator(o.creator);
+    p->set_creator_incarnation(o.creator_incarnation);
+    p->set_creator_frame(o.creator_frame);
+    p->set_plane(o.plane);
+    p->set_observer_plane(o.observer_plane);
+    p->set_normal_x(o.normal.x());
+    p->set_normal_y(o.normal.y());
+    p->set_normal_z(o.normal.z());
+    p->set_offset(o.offset);
+    p->set_centroid_x(o.centroid.x());
+    p->set_centroid_y(o.centroid.y());
+    p->set_centroid_z(o.centroid.z());
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) p->add_covariance(o.covariance(r, c));
+    }
+  }
   return m.SerializeAsString();
 }
 
@@ -362,6 +390,58 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       g.antenna = Eigen::Vector3d(m.antenna_x(), m.antenna_y(), m.antenna_z());
       if (!g.antenna.allFinite() || g.antenna.norm() > 20.0)
         return DataLossError(what + ": the antenna is not on the robot");
+      return in;
+    }
+    case TeamItemKind::kPlaneObservations: {
+      exchange::PlaneObservationsItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      const size_t count = static_cast<size_t>(m.observations_size());
+      if (count == 0) return DataLossError(what + ": has no observations");
+      if (count > kMaxPlaneObservations)
+        return DataLossError(what + ": has " + std::to_string(count) + " observations, more than " +
+                             std::to_string(kMaxPlaneObservations));
+      in.kind = TeamInput::Kind::kPlaneObservations;
+      in.planes.reserve(count);
+      for (size_t k = 0; k < count; ++k) {
+        const exchange::PlaneObservation& p = m.observations(static_cast<int>(k));
+        const std::string which = what + ": observation " + std::to_string(k);
+        if (p.observer().empty() || p.creator().empty() || p.observer().size() > 64 ||
+            p.creator().size() > 64)
+          return DataLossError(which + " names no observer or no creator robot");
+        if (p.plane() > kMaxPlaneIndex || p.observer_plane() > kMaxPlaneIndex)
+          return DataLossError(which + ": plane index " +
+                               std::to_string(std::max(p.plane(), p.observer_plane())) + " is above " +
+                               std::to_string(kMaxPlaneIndex));
+        if (p.covariance_size() != 9)
+          return DataLossError(which + ": the covariance has " + std::to_string(p.covariance_size()) +
+                               " entries, not 9");
+        TeamPlaneObservation o;
+        o.observer = p.observer();
+        o.observer_letter = letter_of(o.observer);
+        o.observer_incarnation = p.observer_incarnation();
+        o.frame = index(o.observer, p.observer_incarnation(), p.frame());
+        o.creator = p.creator();
+        o.creator_letter = letter_of(o.creator);
+        o.creator_incarnation = p.creator_incarnation();
+        o.creator_frame = index(o.creator, p.creator_incarnation(), p.creator_frame());
+        o.plane = p.plane();
+        o.observer_plane = p.observer_plane();
+        o.normal = Eigen::Vector3d(p.normal_x(), p.normal_y(), p.normal_z());
+        o.offset = p.offset();
+        o.centroid = Eigen::Vector3d(p.centroid_x(), p.centroid_y(), p.centroid_z());
+        for (int i = 0; i < 9; ++i) o.covariance(i / 3, i % 3) = p.covariance(i);
+        if (!o.normal.allFinite() || !std::isfinite(o.offset) || !o.centroid.allFinite() ||
+            !o.covariance.allFinite())
+          return DataLossError(which + ": a value is not finite");
+        if (std::abs(1.0 - o.normal.norm()) > 1e-3)
+          return DataLossError(which + ": the normal is not of unit length");
+        // Relative: plane covariances are small (rad^2, m^2) and were floats before.
+        if ((o.covariance - o.covariance.transpose()).norm() > 1e-6 * o.covariance.norm())
+          return DataLossError(which + ": the covariance is not symmetric");
+        if (o.covariance.llt().info() != Eigen::Success)
+          return DataLossError(which + ": the covariance is not positive definite");
+        in.planes.push_back(std::move(o));
+      }
       return in;
     }
   }

@@ -3,6 +3,7 @@
 // payloads back into the pipeline's plain structs. Decoding checks everything a teammate could get
 // wrong (sizes, non-finite numbers, rotations that are not rotations) and names the item.
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -25,6 +26,7 @@ enum class TeamItemKind : uint16_t {
   kAttempt = 6,
   kDetection = 7,
   kGnssFix = 8,
+  kPlaneObservations = 9,
 };
 
 // Which lane an item of `kind` travels in (submaps behind the constraints).
@@ -47,6 +49,12 @@ class TeamItemCodec {
   static std::string Attempt(const TeamMatch& pair, bool matched, const std::string& outcome);
   static std::string Detection(uint32_t incarnation, const TeamDetection& detection);
   static std::string GnssFix(uint32_t incarnation, const TeamGnssFix& fix);
+  // The observations name their robots and runs themselves (frames as the wire names them).
+  static std::string PlaneObservations(const std::vector<TeamPlaneObservation>& observations);
+  // Most observations one item may carry (one submap's; teammates refuse more), and the highest
+  // plane index an observation may name.
+  static constexpr size_t kMaxPlaneObservations = 4096;
+  static constexpr uint32_t kMaxPlaneIndex = 255;
 
   // How a decoded item names graph variables: a robot's letter (0 for a robot not in the team
   // file) and the index of its frame `frame` of run `incarnation`.

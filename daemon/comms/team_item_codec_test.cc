@@ -1,7 +1,9 @@
 #include "daemon/comms/team_item_codec.h"
 
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -247,6 +249,139 @@ TEST(TeamItemCodecTest, GnssFixRoundTripsAndLiesAreRefused) {
                                    TestNames());
   EXPECT_NE(out.status().ToString().find("9 values"), std::string::npos);
   EXPECT_NE(out.status().ToString().find("gnss_fix"), std::string::npos);  // names the item
+}
+
+std::vector<TeamPlaneObservation> PlaneObservations() {
+  // Submap 6 of hexa's run 1: a plane it creates, and one that re-observes rover1's landmark.
+  TeamPlaneObservation own;
+  own.observer = "hexa";
+  own.observer_incarnation = 1;
+  own.frame = 6;
+  own.creator = "hexa";
+  own.creator_incarnation = 1;
+  own.creator_frame = 6;
+  own.plane = 3;
+  own.observer_plane = 3;
+  own.normal = Eigen::Vector3d(0.6, 0.0, 0.8);
+  own.offset = -2.5;
+  own.centroid = Eigen::Vector3d(1.0, 2.0, 0.5);
+  own.covariance << 4e-4, 1e-5, 2e-5, 1e-5, 3e-4, -1e-5, 2e-5, -1e-5, 1e-3;
+  TeamPlaneObservation seen = own;
+  seen.creator = "rover1";
+  seen.creator_incarnation = 0;
+  seen.creator_frame = 11;
+  seen.plane = 255;
+  seen.observer_plane = 1;
+  seen.normal = Eigen::Vector3d(0.0, -1.0, 0.0);
+  seen.offset = 7.25;
+  seen.centroid = Eigen::Vector3d(-3.0, 0.25, 1.5);
+  seen.covariance = Eigen::Vector3d(1e-4, 2e-4, 5e-3).asDiagonal();
+  return {own, seen};
+}
+
+TEST(TeamItemCodecTest, PlaneObservationsNameTheirRobotsRunsAndFrames) {
+  EXPECT_EQ(LaneOf(TeamItemKind::kPlaneObservations), LaneOf(TeamItemKind::kMatch));
+  const std::vector<TeamPlaneObservation> sent = PlaneObservations();
+  auto in = TeamItemCodec::Decode(
+      Item("hexa", TeamItemKind::kPlaneObservations, TeamItemCodec::PlaneObservations(sent)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->kind, TeamInput::Kind::kPlaneObservations);
+  EXPECT_EQ(in->robot, "hexa");
+  EXPECT_EQ(in->letter, 'b');
+  ASSERT_EQ(in->planes.size(), 2u);
+  const char creator_letters[2] = {'b', 'a'};
+  const uint64_t creator_frames[2] = {(uint64_t{1} << 40) | 6, 11};
+  for (size_t k = 0; k < 2; ++k) {
+    SCOPED_TRACE(k);
+    const TeamPlaneObservation& got = in->planes[k];
+    const TeamPlaneObservation& want = sent[k];
+    EXPECT_EQ(got.observer, "hexa");
+    EXPECT_EQ(got.observer_letter, 'b');
+    EXPECT_EQ(got.observer_incarnation, 1u);
+    EXPECT_EQ(got.frame, (uint64_t{1} << 40) | 6);
+    EXPECT_EQ(got.creator, want.creator);
+    EXPECT_EQ(got.creator_letter, creator_letters[k]);
+    EXPECT_EQ(got.creator_incarnation, want.creator_incarnation);
+    EXPECT_EQ(got.creator_frame, creator_frames[k]);
+    EXPECT_EQ(got.plane, want.plane);
+    EXPECT_EQ(got.observer_plane, want.observer_plane);
+    EXPECT_EQ(got.normal, want.normal);
+    EXPECT_EQ(got.offset, want.offset);
+    EXPECT_EQ(got.centroid, want.centroid);
+    EXPECT_EQ(got.covariance, want.covariance);
+  }
+}
+
+TEST(TeamItemCodecTest, PlaneObservationsRefuseWhatATeammateCouldGetWrong) {
+  const auto refused = [](const std::vector<TeamPlaneObservation>& bad) {
+    auto out = TeamItemCodec::Decode(
+        Item("hexa", TeamItemKind::kPlaneObservations, TeamItemCodec::PlaneObservations(bad)), TestNames());
+    return out.ok() ? std::string() : out.status().ToString();
+  };
+  const std::vector<TeamPlaneObservation> good = PlaneObservations();
+  ASSERT_EQ(refused(good), "");
+  const auto with = [&](const std::function<void(TeamPlaneObservation*)>& spoil) {
+    std::vector<TeamPlaneObservation> bad = good;
+    spoil(&bad[1]);
+    return refused(bad);
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+
+  EXPECT_NE(refused({}).find("no observations"), std::string::npos) << refused({});
+  EXPECT_NE(refused({}).find("plane_observations"), std::string::npos);  // names the item
+  const std::vector<TeamPlaneObservation> many(TeamItemCodec::kMaxPlaneObservations + 1, good[0]);
+  EXPECT_NE(refused(many).find("4097 observations"), std::string::npos) << refused(many);
+  std::vector<TeamPlaneObservation> most(TeamItemCodec::kMaxPlaneObservations, good[0]);
+  EXPECT_EQ(refused(most), "");
+
+  const std::function<void(TeamPlaneObservation*)> not_finite[] = {
+      [&](TeamPlaneObservation* o) { o->normal.x() = nan; },
+      [&](TeamPlaneObservation* o) { o->offset = inf; },
+      [&](TeamPlaneObservation* o) { o->centroid.z() = -inf; },
+      [&](TeamPlaneObservation* o) { o->covariance(1, 2) = nan; },
+  };
+  std::string why;
+  for (const auto& spoil : not_finite) {
+    why = with(spoil);
+    EXPECT_NE(why.find("observation 1: a value is not finite"), std::string::npos) << why;
+  }
+
+  why = with([](TeamPlaneObservation* o) { o->normal *= 1.002; });
+  EXPECT_NE(why.find("not of unit length"), std::string::npos) << why;
+  EXPECT_EQ(with([](TeamPlaneObservation* o) { o->normal *= 1.0005; }), "");
+  why = with([](TeamPlaneObservation* o) { o->normal.setZero(); });
+  EXPECT_NE(why.find("not of unit length"), std::string::npos) << why;
+
+  why = with([](TeamPlaneObservation* o) { o->covariance(0, 2) += 1e-6; });
+  EXPECT_NE(why.find("not symmetric"), std::string::npos) << why;
+  why = with([](TeamPlaneObservation* o) { o->covariance(2, 2) = -1e-3; });
+  EXPECT_NE(why.find("not positive definite"), std::string::npos) << why;
+  EXPECT_NE(with([](TeamPlaneObservation* o) { o->covariance.setZero(); }).find("not positive definite"),
+            std::string::npos);
+
+  why = with([](TeamPlaneObservation* o) { o->plane = 256; });
+  EXPECT_NE(why.find("plane index 256"), std::string::npos) << why;
+  why = with([](TeamPlaneObservation* o) { o->observer_plane = 300; });
+  EXPECT_NE(why.find("plane index 300"), std::string::npos) << why;
+  why = with([](TeamPlaneObservation* o) { o->observer.clear(); });
+  EXPECT_NE(why.find("names no observer"), std::string::npos) << why;
+  why = with([](TeamPlaneObservation* o) { o->creator.clear(); });
+  EXPECT_NE(why.find("no creator"), std::string::npos) << why;
+
+  // A covariance of the wrong size only comes off the wire.
+  for (int entries : {0, 8, 10}) {
+    exchange::PlaneObservationsItem m;
+    m.ParseFromString(TeamItemCodec::PlaneObservations(good));
+    auto* covariance = m.mutable_observations(1)->mutable_covariance();
+    while (covariance->size() > entries) covariance->RemoveLast();
+    while (covariance->size() < entries) covariance->Add(0.0);
+    auto out = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kPlaneObservations, m.SerializeAsString()),
+                                     TestNames());
+    ASSERT_FALSE(out.ok());
+    why = out.status().ToString();
+    EXPECT_NE(why.find("has " + std::to_string(entries) + " entries, not 9"), std::string::npos) << why;
+  }
 }
 
 }  // namespace

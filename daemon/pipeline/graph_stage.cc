@@ -10,6 +10,7 @@
 #include "common/heap_bytes.h"
 #include "common/monotonic_clock.h"
 #include "detection/gravity_agreement.h"
+#include "estimation/graph/plane_factors.h"
 
 namespace cairn {
 namespace {
@@ -254,6 +255,10 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       AddDetection(d, true, "");
       break;
     }
+    case TeamInput::Kind::kPlaneObservations: {
+      for (const TeamPlaneObservation& o : in.planes) pending_planes_.push_back(o);
+      break;
+    }
     case TeamInput::Kind::kMatch: {
       if (in.match.letter_a == 0 || in.match.letter_b == 0) break;  // a robot not in the team file
       pending_matches_.push_back(PendingMatch{in.match.letter_a, in.match.letter_b, in.match.frame_a, in.match.frame_b,
@@ -264,9 +269,120 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       break;
   }
   RetryPendingMatches();
+  RetryPendingPlanes();
   // New estimates of a teammate, or a tie to its subgraph, may place its waiting fixes.
   if (!pending_fixes_.empty() && in.kind != TeamInput::Kind::kGnssFix) RetryPendingFixes();
   Update();
+}
+
+uint64_t PlaneLandmarkKey(char letter, uint64_t frame, uint32_t plane) {
+  // The run in the top bits as in frame indices; the frame and the plane (< 256) below them.
+  const uint64_t local = ((LocalIndex(frame) << 8) | (plane & 0xffu)) & ((uint64_t{1} << kRunShift) - 1);
+  return VariableKey(VariableKind::kPlane, letter,
+                     (static_cast<uint64_t>(RunOfIndex(frame)) << kRunShift) | local);
+}
+
+Status GraphStage::AddPlaneObservation(const TeamPlaneObservation& o) {
+  if (o.observer_letter == 0 || o.creator_letter == 0) {
+    return InvalidArgumentError("plane observation naming a robot not in the team");
+  }
+  if (o.plane > 255 || o.observer_plane > 255)
+    return InvalidArgumentError("plane observation: plane index above 255");
+  const uint64_t s = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
+  const uint64_t l = PlaneLandmarkKey(o.creator_letter, o.creator_frame, o.plane);
+  if (plane_factors_.count({s, l}) != 0) return AlreadyExistsError("plane observation held already");
+  const std::vector<uint64_t> loose = graph_.Unconnected();
+  if (!graph_.HasVariable(s) || std::find(loose.begin(), loose.end(), s) != loose.end()) {
+    return NotFoundError(std::string("plane observation by origin ") + o.observer_letter +
+                         std::to_string(o.frame) + ": not tied to this robot's origins yet");
+  }
+  const Eigen::LLT<Eigen::Matrix3d> llt(o.covariance);
+  if (!o.normal.allFinite() || !std::isfinite(o.offset) || !o.centroid.allFinite() ||
+      !o.covariance.allFinite() || llt.info() != Eigen::Success || std::abs(o.normal.norm() - 1.0) > 1e-3) {
+    return InvalidArgumentError(
+        "plane observation with a non-finite plane, a normal not of unit length or a "
+        "covariance not positive definite");
+  }
+  const bool new_landmark = !graph_.HasVariable(l);
+  SlamFactor f;
+  f.kind = FactorKind::kPlaneObservation;
+  f.a = s;
+  f.b = l;
+  const Eigen::Vector3d n = o.normal.normalized();
+  f.plane = Eigen::Vector4d(n.x(), n.y(), n.z(), o.offset);
+  f.plane_information = o.covariance.inverse();
+  f.plane_information = 0.5 * (f.plane_information + f.plane_information.transpose());
+  // Where a new landmark starts: the face's centroid, moved onto the plane.
+  f.z = PlaneLandmarkFrame(n, o.centroid - (n.dot(o.centroid) + o.offset) * n);
+  const size_t errors = report_.errors.size();
+  if (!Add(f)) {
+    return InvalidArgumentError(report_.errors.size() > errors ? report_.errors.back()
+                                                               : "the graph refused it");
+  }
+  plane_factors_.insert({s, l});
+  ++report_.plane_observations;
+  if (new_landmark) ++report_.plane_landmarks;
+  Update();
+  return Status::Ok();
+}
+
+Expected<double> GraphStage::PlaneObservationChi2(const TeamPlaneObservation& o) const {
+  const uint64_t s = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
+  const uint64_t l = PlaneLandmarkKey(o.creator_letter, o.creator_frame, o.plane);
+  if (plane_factors_.count({s, l}) == 0) return NotFoundError("plane observation not in the graph");
+  const Eigen::Vector3d n = o.normal.normalized();
+  const Eigen::Matrix3d information = o.covariance.inverse();
+  const Eigen::Vector3d e =
+      PlaneObservationResidual(Eigen::Vector4d(n.x(), n.y(), n.z(), o.offset), information)
+          .Error(*graph_.Pose(s), *graph_.Pose(l));
+  return e.dot(information * e);
+}
+
+bool GraphStage::PlaceOrigins(const std::vector<std::pair<char, uint64_t>>& origins,
+                              std::vector<SubmapPlacement>* out, std::string* why) {
+  out->clear();
+  std::vector<uint64_t> keys;
+  const std::vector<uint64_t> unconnected = graph_.Unconnected();
+  const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
+  for (const auto& [letter, frame] : origins) {
+    const uint64_t key = VariableKey(VariableKind::kSubmap, letter, frame);
+    if (!graph_.HasVariable(key) || loose.count(key) != 0) {
+      *why = std::string("origin ") + letter + std::to_string(frame) + " not tied to this robot's";
+      return false;
+    }
+    keys.push_back(key);
+  }
+  const auto covariances = graph_.Covariances(keys);
+  if (!covariances.ok()) {
+    *why = "covariances: " + covariances.status().ToString();
+    return false;
+  }
+  for (size_t i = 0; i < keys.size(); ++i)
+    out->push_back(SubmapPlacement{ToIsometry(*graph_.Pose(keys[i])), (*covariances)[i]});
+  return true;
+}
+
+void GraphStage::RetryPendingPlanes() {
+  if (pending_planes_.empty()) return;
+  // Retried at every teammate's item while their submaps float: one look at the graph for all.
+  const std::vector<uint64_t> unconnected = graph_.Unconnected();
+  const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
+  for (size_t i = 0; i < pending_planes_.size();) {
+    const TeamPlaneObservation& o = pending_planes_[i];
+    const uint64_t origin = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
+    if (o.observer_letter != 0 && (!graph_.HasVariable(origin) || loose.count(origin) != 0)) {
+      ++i;
+      continue;
+    }
+    const Status s = AddPlaneObservation(o);
+    if (s.code() == StatusCode::kNotFound) {
+      ++i;
+      continue;
+    }
+    if (s.ok()) ++report_.team_factors;
+    pending_planes_.erase(pending_planes_.begin() + static_cast<long>(i));
+  }
+  report_.plane_observations_pending = pending_planes_.size();
 }
 
 void GraphStage::RetryPendingMatches() {
@@ -765,7 +881,7 @@ GraphScene GraphStage::Scene(bool covariances) {
   };
   for (uint64_t key : graph_.VariableKeys()) {
     if (loose.count(key) != 0) continue;  // where the graph cannot place it yet: not drawn
-    if (KindOfKey(key) == VariableKind::kDatum) continue;
+    if (KindOfKey(key) == VariableKind::kDatum || KindOfKey(key) == VariableKind::kPlane) continue;
     auto p = graph_.Pose(key);
     if (!p.ok()) continue;
     GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero(), ""};
@@ -812,8 +928,8 @@ GraphScene GraphStage::Scene(bool covariances) {
 PoseGraph GraphStage::ExportPoseGraph() const {
   PoseGraph g;
   for (uint64_t key : graph_.VariableKeys()) {
-    // The datum has no pose edges (its GNSS factors are not g2o's).
-    if (KindOfKey(key) == VariableKind::kDatum) continue;
+    // The datum and the planes have no pose edges (their factors are not g2o's).
+    if (KindOfKey(key) == VariableKind::kDatum || KindOfKey(key) == VariableKind::kPlane) continue;
     if (auto p = graph_.Pose(key); p.ok()) g.SetVertex(key, *p);
   }
   g.set_has_initial_estimate(true);

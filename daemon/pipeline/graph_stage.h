@@ -9,7 +9,9 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -23,6 +25,7 @@
 #include "estimation/graph/pose_graph.h"
 #include "estimation/graph/slam_graph.h"
 #include "mapping/matching/four_dof_transform.h"
+#include "mapping/matching/plane_associator.h"
 
 namespace cairn {
 
@@ -40,6 +43,9 @@ struct GraphStageReport {
   uint64_t team_inputs = 0;      // teammates' items taken
   uint64_t team_factors = 0;     // teammates' w, v and c factors added
   uint64_t team_matches_pending = 0;  // waiting for an origin not in the graph yet
+  uint64_t plane_landmarks = 0;       // plane landmarks l started
+  uint64_t plane_observations = 0;    // their observations o added (own and teammates')
+  uint64_t plane_observations_pending = 0;  // a teammate's, its submap not tied to this robot's yet
   uint64_t detections = 0;            // robot detections d added (own and teammates')
   uint64_t landmark_observations = 0; // landmark observations o added
   uint64_t detections_pending = 0;    // waiting for a robot's estimates around their time
@@ -82,6 +88,10 @@ struct OriginEstimate {
   bool connected = true;  // to the robot's prior
 };
 
+// The graph key of the plane landmark named by its first observation: plane `plane` of the
+// submap at graph frame index `frame` of robot `letter`.
+uint64_t PlaneLandmarkKey(char letter, uint64_t frame, uint32_t plane);
+
 class GraphStage {
  public:
   GraphStage(const GraphStageOptions& options, bool deterministic);
@@ -115,6 +125,17 @@ class GraphStage {
   const Eigen::Vector3d& gnss_antenna() const { return gnss_.antenna(); }
   // T_world_enu of the GNSS datum; false before fixes have started it.
   bool Datum(Eigen::Isometry3d* T_world_enu) const;
+  // A plane landmark observation o (this robot's or a teammate's, by graph letters and frame
+  // indices). NotFound while the observing submap is not in the graph or not tied to this robot's
+  // (a teammate's: it waits and is retried); AlreadyExists for one the graph holds; other errors
+  // for what the graph refused.
+  Status AddPlaneObservation(const TeamPlaneObservation& observation);
+  // The squared Mahalanobis residual of an observation the graph holds, at the current estimate.
+  Expected<double> PlaneObservationChi2(const TeamPlaneObservation& observation) const;
+  // The origins (graph letter, frame index) with their marginal covariances; false, with the
+  // reason, when one is not in the graph, not tied to this robot's, or the covariances fail.
+  bool PlaceOrigins(const std::vector<std::pair<char, uint64_t>>& origins, std::vector<SubmapPlacement>* out,
+                    std::string* why);
   // Landmark carriers by name: the index of each is its variable's.
   void SetLandmarks(const std::vector<std::string>& names) { landmarks_ = names; }
   const std::vector<DetectionRecord>& detections() const { return detection_records_; }
@@ -152,6 +173,7 @@ class GraphStage {
   // Time of the last estimate placed, and the number of submap origins (cheap, for live updates).
   Timestamp last_time() const { return estimates_.empty() ? Timestamp() : estimates_.back().time; }
   uint64_t submap_origins() const { return report_.submap_origins; }
+  uint64_t factors_added() const { return report_.factors; }
   // Whether the last estimate taken became graph pose `*index` (a factor v).
   bool last_estimate_is_pose(uint64_t* index) const {
     *index = last_pose_index_;
@@ -207,6 +229,9 @@ class GraphStage {
   };
   std::vector<PendingMatch> pending_matches_;
   void RetryPendingMatches();
+  std::vector<TeamPlaneObservation> pending_planes_;
+  std::set<std::pair<uint64_t, uint64_t>> plane_factors_;  // (origin, landmark) held
+  void RetryPendingPlanes();
   // Detections.
   struct PoseCovariance {
     Timestamp time;

@@ -143,6 +143,9 @@ Status Pipeline::EnableMatching(const SubmapMatchingOptions& options, const std:
   if (Status s = options.matcher.Validate(); !s.ok()) return s.WithContext("matching.matcher");
   matching_ = std::make_unique<SubmapMatchingStage>(options, robot, deterministic_, matcher_options_,
                                                     [this] { graph_signal_.Notify(); });
+  if (options.plane_landmarks.enabled) {
+    planes_ = std::make_unique<PlaneLandmarkStage>(options.plane_landmarks, graph_->robot(), robot);
+  }
   mapping_->PublishSubmapsTo(&submap_queue_);
   return Status::Ok();
 }
@@ -152,6 +155,7 @@ Status Pipeline::SetTeamLink(TeamLink* team, std::map<char, std::string> names) 
   if (!graph_) return FailedPreconditionError("the team exchange needs the graph enabled");
   team_ = team;
   for (const auto& [letter, name] : names) letters_[name] = letter;
+  if (planes_) planes_->SetTeam(names, team);
   if (matching_) matching_->SetTeam(std::move(names), team);
   team_->SetNotify([this] { graph_signal_.Notify(); });
   // Finished submaps travel to the team even without the matcher.
@@ -234,7 +238,7 @@ void Pipeline::StopAndDrain() {
       const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(team_->linger_seconds());
       while (!team_->Settled() && std::chrono::steady_clock::now() < deadline) {
         const bool took = TakeTeamInputs();
-        if (matching_) matching_->Step(*graph_);
+        StepSubmapWork();
         team_->SetIdle(!took && (matching_ == nullptr || matching_->Idle()));
         if (!took) std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
@@ -243,6 +247,7 @@ void Pipeline::StopAndDrain() {
     if (matching_) {
       TakeSubmaps(UINT64_MAX);
       matching_->Drain(*graph_);
+      if (planes_) planes_->Step(*graph_);
     }
     graph_->Finish();  // waits for a running full solve, so its worker stops after it
     graph_full_solve_exec_.RequestStop();
@@ -505,9 +510,16 @@ void Pipeline::TakeMappingInputs() {
   }
 }
 
+void Pipeline::StepSubmapWork() {
+  if (matching_) matching_->Step(*graph_);
+  // After the matcher: its matches tie teammates' origins, which places their faces.
+  if (planes_) planes_->Step(*graph_);
+}
+
 void Pipeline::TakeSubmaps(uint64_t max_id) {
   while (const std::shared_ptr<const Submap>* s = submap_queue_.Front()) {
     if ((*s)->metadata().id > max_id) return;
+    if (planes_) planes_->OnSubmap(graph_->robot(), (*s)->metadata().id, **s);
     if (matching_) matching_->OnSubmap(*s);
     if (team_) team_->PublishSubmap(*s);
     submap_queue_.PopFront();
@@ -533,7 +545,9 @@ bool Pipeline::TakeTeamInputs() {
     if (in.kind == TeamInput::Kind::kSubmap && in.submap) {
       team_submaps_[in.letter][in.new_frame] = in.submap;
       if (matching_) matching_->OnTeamSubmap(in.robot, in.new_frame, in.submap);
+      if (planes_) planes_->OnSubmap(in.letter, in.new_frame, *in.submap);
     }
+    if (planes_ && in.kind == TeamInput::Kind::kPlaneObservations) planes_->OnTeamObservations(in.planes);
     if (matching_ && (in.kind == TeamInput::Kind::kAttempt || in.kind == TeamInput::Kind::kMatch)) {
       matching_->OnTeamAttempt(in.match, in.kind == TeamInput::Kind::kMatch || in.matched);
     }
@@ -694,7 +708,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
       worked = true;
       if (matching_ && into_frame && frame >= 2) {
         TakeSubmaps(deterministic_ ? frame - 2 : UINT64_MAX);
-        matching_->Step(*graph_);
+        StepSubmapWork();
       }
     }
     if (detection_ && !deterministic_) TakeSightings(Timestamp::FromNanoseconds(INT64_MAX));
@@ -702,7 +716,7 @@ void Pipeline::GraphLoop(std::stop_token stop) {
     if (worked && predict_carriers_) PublishPredictions();
     if (matching_ && !deterministic_) {
       TakeSubmaps(UINT64_MAX);
-      matching_->Step(*graph_);
+      StepSubmapWork();
     }
     if (team_) {
       if (!matching_) TakeSubmaps(UINT64_MAX);

@@ -20,6 +20,7 @@
 #include "daemon/pipeline/graph_stage.h"
 #include "daemon/pipeline/latency_histogram.h"
 #include "daemon/pipeline/mapping_stage.h"
+#include "daemon/pipeline/plane_landmark_stage.h"
 #include "daemon/pipeline/queued.h"
 #include "daemon/pipeline/robot_detection_stage.h"
 #include "daemon/pipeline/sensor_stream_stats.h"
@@ -177,6 +178,8 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   const RobotDetectionStage* detection() const { return detection_.get(); }
   // Valid after StopAndDrain(); null when matching is not enabled.
   const SubmapMatchingStage* matching() const { return matching_.get(); }
+  // Valid after StopAndDrain(); null when plane landmarks are not enabled.
+  const PlaneLandmarkStage* plane_landmarks() const { return planes_.get(); }
   FaultReport fault_report() const;
 
   // Live progress (any thread).
@@ -287,6 +290,9 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   std::unique_ptr<MappingStage> mapping_;
   std::unique_ptr<GraphStage> graph_;
   std::unique_ptr<SubmapMatchingStage> matching_;
+  std::unique_ptr<PlaneLandmarkStage> planes_;
+  // The submaps' comparisons (matcher, plane landmarks) at a fixed point of the graph's input.
+  void StepSubmapWork();
   std::unique_ptr<RobotDetectionStage> detection_;
   int64_t detection_every_ = 1;
   uint64_t detection_counter_ = 0;  // stereo thread

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "common/options_visitor.h"
+#include "daemon/pipeline/plane_landmark_options.h"
 #include "mapping/matching/submap_feature_extractor.h"
 #include "mapping/matching/submap_matcher.h"
 #include "mapping/matching/submap_pairing.h"
@@ -26,6 +27,7 @@ struct SubmapMatchingOptions {
   SubmapFeatureOptions features;
   SubmapPairingOptions pairing;
   SubmapMatcherOptions matcher;
+  PlaneLandmarkOptions plane_landmarks;
 
   void Visit(OptionsVisitor& v) {
     v.Flag("enabled", enabled);
@@ -37,6 +39,7 @@ struct SubmapMatchingOptions {
     v.Section("features", features);
     v.Section("pairing", pairing);
     v.Section("matcher", matcher);
+    v.Section("plane_landmarks", plane_landmarks);
   }
 };
 

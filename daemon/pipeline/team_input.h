@@ -91,6 +91,28 @@ struct TeamGnssFix {
   Eigen::Vector3d antenna = Eigen::Vector3d::Zero();
 };
 
+// A plane landmark observation o: submap `frame` of `observer` saw the landmark named by its first
+// observation (plane `plane` of `creator`'s submap `creator_frame`), measured in the submap's
+// gravity-aligned frame as normal . p + offset = 0, with `covariance` that of (a, b, d) in
+// SubmapPlane's tangent axes, and `centroid` (in the submap's frame) where the landmark is placed
+// when this observation creates it.
+struct TeamPlaneObservation {
+  std::string observer;               // robot names
+  char observer_letter = 0;           // graph letters (from the team file)
+  uint32_t observer_incarnation = 0;  // the runs (on the wire; decoded frames include them)
+  uint64_t frame = 0;
+  uint32_t observer_plane = 0;  // index in the observer's submap
+  std::string creator;
+  char creator_letter = 0;
+  uint32_t creator_incarnation = 0;
+  uint64_t creator_frame = 0;
+  uint32_t plane = 0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double offset = 0.0;  // m
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // rad, rad, m
+};
+
 struct TeamInput {
   enum class Kind : uint8_t {
     kRunStart,
@@ -100,7 +122,8 @@ struct TeamInput {
     kMatch,
     kAttempt,
     kDetection,
-    kGnssFix
+    kGnssFix,
+    kPlaneObservations
   };
   Kind kind = Kind::kRunStart;
   std::string robot;   // the item's origin
@@ -125,6 +148,8 @@ struct TeamInput {
   TeamDetection detection;
   // kGnssFix
   TeamGnssFix gnss;
+  // kPlaneObservations: one robot's decisions for one of its submaps
+  std::vector<TeamPlaneObservation> planes;
 };
 
 }  // namespace cairn

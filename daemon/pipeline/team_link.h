@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "daemon/pipeline/estimation_stage.h"
 #include "daemon/pipeline/team_input.h"
@@ -25,6 +26,9 @@ class TeamLink {
   virtual void PublishDetection(const TeamDetection& detection) = 0;
   // A GNSS fix the graph took (its letter and run are this robot's).
   virtual void PublishGnssFix(const TeamGnssFix& fix) = 0;
+  // Plane landmark observations: one robot's decisions for one of its submaps (graph frame
+  // indices, as the graph names them).
+  virtual void PublishPlaneObservations(const std::vector<TeamPlaneObservation>& observations) = 0;
   // Teammates' items not taken yet; false when there are none.
   virtual bool NextInput(TeamInput* input) = 0;
   // Called (from the comms thread) when inputs arrive, to wake the graph thread.

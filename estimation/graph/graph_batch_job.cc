@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <set>
 
 #include <ceres/ceres.h>
 
 #include "estimation/graph/chordal_initializer.h"
+#include "estimation/graph/plane_factors.h"
 #include "estimation/graph/pose_factors.h"
 
 namespace cairn {
@@ -56,6 +58,14 @@ Status InitializeSnapshotChordal(GraphSnapshot& s) {
   }
   CAIRN_RETURN_IF_ERROR(InitializeChordal(g));
   for (size_t i = 0; i < g.num_vertices(); ++i) s.poses[index(g.ids()[i])] = g.poses()[i];
+  // Plane landmarks are no vertices of the pose graph: each goes back onto the plane as the submap
+  // that created it (its first observation) now sees it.
+  std::set<uint64_t> placed;
+  for (const auto& f : s.factors) {
+    if (f.kind == FactorKind::kPlaneObservation && placed.insert(f.b).second) {
+      s.poses[index(f.b)] = s.poses[index(f.a)] * f.z;
+    }
+  }
   return Status::Ok();
 }
 
@@ -76,6 +86,7 @@ void GraphBatchJob::Run() {
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(po);
   const auto manifold = MakePoseManifold();
+  const auto plane_manifold = MakePlaneLandmarkManifold();
   ceres::CauchyLoss cauchy(cauchy_c_ > 0.0 ? cauchy_c_ : 1.0);
   auto block = [&](uint64_t key) {
     return &blocks[7 * static_cast<size_t>(std::lower_bound(s.keys.begin(), s.keys.end(), key) - s.keys.begin())];
@@ -91,7 +102,7 @@ void GraphBatchJob::Run() {
   for (size_t i = 0; i < n; ++i) {
     double* b = &blocks[7 * i];
     if (!problem.HasParameterBlock(b)) continue;
-    problem.SetManifold(b, manifold.get());
+    problem.SetManifold(b, IsPlaneVariable(s.keys[i]) ? plane_manifold.get() : manifold.get());
     if (s.constant[i]) problem.SetParameterBlockConstant(b);
   }
   stats_ = SolveGraphProblem(problem, static_cast<int>(iterations_), 1e9);

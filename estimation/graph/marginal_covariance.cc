@@ -1,6 +1,7 @@
 #include "estimation/graph/marginal_covariance.h"
 
 #include <algorithm>
+#include <string>
 
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCore>
@@ -32,17 +33,32 @@ Expected<MarginalCovariance> MarginalCovariance::FromProblem(ceres::Problem& pro
   std::vector<double*> all, variable;
   problem.GetParameterBlocks(&all);
   std::unordered_map<const double*, int> index;
+  // Columns of the Jacobian: block and position within it (a block's tangent may be smaller).
+  std::vector<int> col_block, col_local;
+  std::vector<int> tangent;
   for (double* block : all) {
     if (problem.IsParameterBlockConstant(block)) continue;  // no column: as ceres::Covariance
-    if (problem.ParameterBlockTangentSize(block) != 6) {
-      return InvalidArgumentError("marginal covariance: a parameter block without a 6-D tangent space");
+    const int size = problem.ParameterBlockTangentSize(block);
+    if (size < 1 || size > 6) {
+      return InvalidArgumentError("marginal covariance: a parameter block with a tangent space of " +
+                                  std::to_string(size) + " dimensions (1 to 6 supported)");
     }
+    for (int d = 0; d < size; ++d) {
+      col_block.push_back(static_cast<int>(variable.size()));
+      col_local.push_back(d);
+    }
+    tangent.push_back(size);
     index[block] = static_cast<int>(variable.size());
     variable.push_back(block);
   }
   MarginalCovariance mc(static_cast<int>(variable.size()));
   mc.index_ = std::move(index);
   if (variable.empty()) return mc;
+  // The unused dimensions of smaller blocks: unit information, coupled to nothing, so they change
+  // no other marginal (and their own rows of it are to be ignored).
+  for (size_t b = 0; b < tangent.size(); ++b) {
+    for (int d = tangent[b]; d < 6; ++d) mc.diagonal_[b](d, d) = 1.0;
+  }
 
   // Listing only the variable blocks fixes the column order (6 per block) and holds the constant
   // ones fixed; the Jacobian is in the tangent space with the losses' corrections applied.
@@ -57,10 +73,11 @@ Expected<MarginalCovariance> MarginalCovariance::FromProblem(ceres::Problem& pro
   for (int r = 0; r < J.num_rows; ++r) {
     row_blocks.clear();
     for (int e = J.rows[static_cast<size_t>(r)]; e < J.rows[static_cast<size_t>(r) + 1]; ++e) {
-      const int col = J.cols[static_cast<size_t>(e)], block = col / 6;
+      const auto col = static_cast<size_t>(J.cols[static_cast<size_t>(e)]);
+      const int block = col_block[col];
       auto it = std::find_if(row_blocks.begin(), row_blocks.end(), [&](const auto& b) { return b.first == block; });
       if (it == row_blocks.end()) it = row_blocks.insert(row_blocks.end(), {block, Vector6d::Zero()});
-      it->second[col % 6] += J.values[static_cast<size_t>(e)];
+      it->second[col_local[col]] += J.values[static_cast<size_t>(e)];
     }
     for (size_t a = 0; a < row_blocks.size(); ++a) {
       for (size_t b = a; b < row_blocks.size(); ++b) {

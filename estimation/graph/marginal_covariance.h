@@ -26,7 +26,8 @@ class MarginalCovariance {
  public:
   explicit MarginalCovariance(int num_blocks);
 
-  // Information of all non-constant parameter blocks of `problem`; each must have a 6-D tangent.
+  // Information of all non-constant parameter blocks of `problem`, whose tangent spaces have at most
+  // 6 dimensions; a smaller block's marginal is the top-left corner of its 6x6 block.
   static Expected<MarginalCovariance> FromProblem(ceres::Problem& problem);
 
   int num_blocks() const { return static_cast<int>(diagonal_.size()); }

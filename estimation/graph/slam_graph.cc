@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <ceres/ceres.h>
 
 #include "estimation/graph/graph_batch_job.h"
 #include "estimation/graph/marginal_covariance.h"
+#include "estimation/graph/plane_factors.h"
 #include "estimation/graph/pose_factors.h"
 #include "estimation/math/so3.h"
 
@@ -18,7 +20,9 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
   using K = VariableKind;
   const K ka = KindOfKey(f.a), kb = KindOfKey(f.b);
   const bool same_robot = RobotOfVariable(f.a) == RobotOfVariable(f.b);
-  auto is = [](K k) { return k == K::kRobotPose || k == K::kSubmap || k == K::kLandmark || k == K::kDatum; };
+  auto is = [](K k) {
+    return k == K::kRobotPose || k == K::kSubmap || k == K::kLandmark || k == K::kDatum || k == K::kPlane;
+  };
   if (!is(ka) || (!IsUnary(f.kind) && !is(kb))) return InvalidArgumentError("factor on a malformed variable key");
   if (!IsUnary(f.kind) && f.a == f.b) return InvalidArgumentError("binary factor on one variable");
   bool ok = true;
@@ -37,9 +41,20 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
     case FactorKind::kGnssPosition:
       ok = ka == K::kDatum && kb == K::kRobotPose;
       break;
+    case FactorKind::kPlaneObservation:
+      ok = ka == K::kSubmap && kb == K::kPlane;
+      break;
   }
   if (!ok) return InvalidArgumentError("factor kind does not fit its variables");
-  if (IsPositionFactor(f.kind)) {
+  if (f.kind == FactorKind::kPlaneObservation) {
+    if (!f.plane.allFinite() || std::abs(f.plane.head<3>().norm() - 1.0) > 1e-6 || !f.z.t.allFinite() ||
+        !f.z.q.coeffs().allFinite()) {
+      return InvalidArgumentError("plane observation with a non-finite plane or a normal not of unit length");
+    }
+    if (f.plane_information.llt().info() != Eigen::Success) {
+      return InvalidArgumentError("plane information is not positive definite");
+    }
+  } else if (IsPositionFactor(f.kind)) {
     if (!f.position.allFinite() || !f.antenna.allFinite()) return InvalidArgumentError("non-finite position");
     if (f.position_information.llt().info() != Eigen::Success) {
       return InvalidArgumentError("position information is not positive definite");
@@ -63,7 +78,7 @@ SlamUpdateStats StatsOf(const GraphSolveResult& r, size_t variables, std::chrono
 }  // namespace
 
 SlamGraph::SlamGraph(const SlamGraphOptions& options)
-    : options_(options), manifold_(MakePoseManifold()) {
+    : options_(options), manifold_(MakePoseManifold()), plane_manifold_(MakePlaneLandmarkManifold()) {
   ceres::Problem::Options po;
   po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -83,6 +98,14 @@ Status SlamGraph::AddFactor(const SlamFactor& f) {
       return InvalidArgumentError("GNSS fix on an unknown datum or pose");
     if (variables_.at(f.a).component != variables_.at(f.b).component) {
       return InvalidArgumentError("GNSS fix on a pose not tied to the datum");
+    }
+  }
+  if (f.kind == FactorKind::kPlaneObservation) {
+    // A plane fixes 3 of a pose's 6 degrees of freedom: it can neither place a submap nor join
+    // components rigidly.
+    if (!HasVariable(f.a)) return InvalidArgumentError("plane observation by an unknown submap");
+    if (HasVariable(f.b) && variables_.at(f.a).component != variables_.at(f.b).component) {
+      return InvalidArgumentError("plane observation across unconnected components");
     }
   }
   ++num_added_factors_;
@@ -112,7 +135,7 @@ SlamGraph::Variable& SlamGraph::CreateVariable(uint64_t key, const Pose3& initia
   v.component = component;
   v.parent = parent;
   creation_order_.push_back(key);
-  problem_->AddParameterBlock(v.block.get(), 7, manifold_.get());
+  problem_->AddParameterBlock(v.block.get(), 7, ManifoldOf(key));
   auto& members = components_[component];
   if (members.empty() && component != own_component_) {
     v.gauge = true;  // first variable of a floating component holds its gauge
@@ -280,7 +303,7 @@ SlamUpdateStats SlamGraph::SolveWindow(const std::vector<uint64_t>& seeds) {
   }
   for (uint64_t key : blocks_of_used) {
     const Variable& v = variables_.at(key);
-    local.SetManifold(v.block.get(), manifold_.get());
+    local.SetManifold(v.block.get(), ManifoldOf(key));
     if (v.gauge || !in_window(key)) local.SetParameterBlockConstant(v.block.get());
   }
   // A window only has to be good until the next full solve: a looser tolerance than the full
@@ -455,6 +478,10 @@ SlamUpdateStats SlamGraph::SolveFinal() {
   return warm;
 }
 
+ceres::Manifold* SlamGraph::ManifoldOf(uint64_t key) const {
+  return IsPlaneVariable(key) ? plane_manifold_.get() : manifold_.get();
+}
+
 Expected<Pose3> SlamGraph::Pose(uint64_t key) const {
   auto it = variables_.find(key);
   if (it == variables_.end()) return NotFoundError("no variable " + std::to_string(key));
@@ -501,6 +528,11 @@ double SlamGraph::Chi2() const {
       chi2 += e.dot(f.position_information * e);
       continue;
     }
+    if (f.kind == FactorKind::kPlaneObservation) {
+      const Eigen::Vector3d e = PlaneObservationResidual(f.plane, f.plane_information).Error(a, *Pose(f.b));
+      chi2 += e.dot(f.plane_information * e);
+      continue;
+    }
     if (f.kind == FactorKind::kGnssPosition) {
       const Pose3 x = *Pose(f.b);
       const Eigen::Vector3d e = a.R().transpose() * (x.t + x.R() * f.antenna - a.t) - f.position;
@@ -535,11 +567,15 @@ Expected<std::vector<Matrix6d>> SlamGraph::Covariances(const std::vector<uint64_
     ++covariance_computations_;
     for (uint64_t key : stale) {
       const int i = covariance->IndexOf(variables_.at(key).block.get());
-      // Ceres' quaternion tangent is half the rotation vector: scale the rotation rows and
-      // columns by 2 so callers get radians.
       Matrix6d c = i < 0 ? Matrix6d::Zero() : covariance->Marginal(i);  // gauge: 0
-      c.bottomRows<3>() *= 2.0;
-      c.rightCols<3>() *= 2.0;
+      if (IsPlaneVariable(key)) {
+        c.bottomRightCorner<3, 3>().setZero();  // (rx, ry, tz) and three unused dimensions
+      } else {
+        // Ceres' quaternion tangent is half the rotation vector: scale the rotation rows and
+        // columns by 2 so callers get radians.
+        c.bottomRows<3>() *= 2.0;
+        c.rightCols<3>() *= 2.0;
+      }
       covariance_cache_[key] = {*Pose(key), c};
     }
     covariance_factor_count_ = factors_.size();

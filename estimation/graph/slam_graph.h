@@ -181,6 +181,7 @@ class SlamGraph {
   SlamUpdateStats SolveWindow(const std::vector<uint64_t>& seeds);
   std::vector<uint64_t> WindowAround(const std::vector<uint64_t>& seeds) const;
   GraphSnapshot Snapshot() const;
+  ceres::Manifold* ManifoldOf(uint64_t key) const;
   // Writes the snapshot's poses back into the variables of the same keys.
   void SetPoses(const GraphSnapshot& snapshot);
   void StartFullSolve(bool chordal);
@@ -192,6 +193,7 @@ class SlamGraph {
   SlamGraphOptions options_;
   std::unique_ptr<ceres::Problem> problem_;
   std::unique_ptr<ceres::Manifold> manifold_;
+  std::unique_ptr<ceres::Manifold> plane_manifold_;
   std::unique_ptr<ceres::LossFunction> cauchy_;
   std::map<uint64_t, Variable> variables_;
   std::vector<uint64_t> creation_order_;

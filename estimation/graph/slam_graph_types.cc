@@ -1,5 +1,6 @@
 #include "estimation/graph/slam_graph_types.h"
 
+#include "estimation/graph/plane_factors.h"
 #include "estimation/graph/pose_factors.h"
 
 namespace cairn {
@@ -9,7 +10,11 @@ bool IsUnary(FactorKind kind) {
          kind == FactorKind::kAbsolutePosition;
 }
 
-bool IsPoseEdge(FactorKind kind) { return !IsUnary(kind) && kind != FactorKind::kGnssPosition; }
+bool IsPoseEdge(FactorKind kind) {
+  return !IsUnary(kind) && kind != FactorKind::kGnssPosition && kind != FactorKind::kPlaneObservation;
+}
+
+bool IsPlaneVariable(uint64_t key) { return KindOfKey(key) == VariableKind::kPlane; }
 
 bool IsPositionFactor(FactorKind kind) {
   return kind == FactorKind::kAbsolutePosition || kind == FactorKind::kGnssPosition;
@@ -18,7 +23,7 @@ bool IsPositionFactor(FactorKind kind) {
 bool IsRobustFactor(FactorKind kind) {
   return kind == FactorKind::kDetection || kind == FactorKind::kLandmark || kind == FactorKind::kMatch ||
          kind == FactorKind::kAbsolutePose || kind == FactorKind::kAbsolutePosition ||
-         kind == FactorKind::kGnssPosition;
+         kind == FactorKind::kGnssPosition || kind == FactorKind::kPlaneObservation;
 }
 
 PoseGraphEdge EdgeOfFactor(const SlamFactor& f) {
@@ -38,6 +43,8 @@ ceres::CostFunction* MakeFactorCostFunction(const SlamFactor& f) {
     case FactorKind::kAbsolutePosition: return AbsolutePositionResidual::Create(f.position, f.position_information);
     case FactorKind::kGnssPosition:
       return GnssPositionResidual::Create(f.position, f.position_information, f.antenna);
+    case FactorKind::kPlaneObservation:
+      return PlaneObservationResidual::Create(f.plane, f.plane_information);
     default: return RelativePoseResidual::Create(f.z, f.information);
   }
 }

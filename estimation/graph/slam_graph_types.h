@@ -13,7 +13,14 @@ class CostFunction;
 namespace cairn {
 
 // kDatum: T_world_enu, the local east-north-up frame of the team's GNSS datum in the graph's world.
-enum class VariableKind : uint8_t { kRobotPose = 'x', kSubmap = 's', kLandmark = 'l', kDatum = 'e' };
+// kPlane: a plane landmark, its frame's x-y plane (plane_factors.h), on a 3-D tangent space.
+enum class VariableKind : uint8_t {
+  kRobotPose = 'x',
+  kSubmap = 's',
+  kLandmark = 'l',
+  kDatum = 'e',
+  kPlane = 'p'
+};
 
 // Variable key: robot letter in the top byte (as the g2o multi-robot keys), kind in the next.
 constexpr uint64_t VariableKey(VariableKind kind, char robot, uint64_t index) {
@@ -35,6 +42,7 @@ enum class FactorKind {
   kAbsolutePose,      // unary pose fix (known landmark, GNSS with heading)
   kAbsolutePosition,  // unary position fix in the world frame (total station)
   kGnssPosition,      // e -> x: the antenna's position in the datum's east-north-up frame
+  kPlaneObservation,  // o: s -> p, a submap's planar face
 };
 
 struct SlamFactor {
@@ -46,6 +54,10 @@ struct SlamFactor {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();               // kAbsolutePosition
   Eigen::Matrix3d position_information = Eigen::Matrix3d::Identity();
   Eigen::Vector3d antenna = Eigen::Vector3d::Zero();  // kGnssPosition: in b's body frame
+  // kPlaneObservation: (n, d) of n . p + d = 0 in a's frame, the information of (a, b, d) in its
+  // tangent axes; z is the plane's frame in a (where the landmark is placed when it creates it).
+  Eigen::Vector4d plane = Eigen::Vector4d(0.0, 0.0, 1.0, 0.0);
+  Eigen::Matrix3d plane_information = Eigen::Matrix3d::Identity();
 };
 
 bool IsUnary(FactorKind kind);
@@ -54,6 +66,8 @@ bool IsUnary(FactorKind kind);
 bool IsPoseEdge(FactorKind kind);
 // Factors whose measurement is a position (3 residuals) rather than a pose.
 bool IsPositionFactor(FactorKind kind);
+// Whether `key` is a variable of 3 degrees of freedom (a plane landmark) rather than a pose.
+bool IsPlaneVariable(uint64_t key);
 // Factors that get the Cauchy loss (thesis 4.2.3: detections, landmarks, matches; also fixes).
 bool IsRobustFactor(FactorKind kind);
 

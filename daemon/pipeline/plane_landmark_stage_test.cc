@@ -1,0 +1,133 @@
+#include "daemon/pipeline/plane_landmark_stage.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "daemon/pipeline/testing/loop_mission.h"
+
+namespace cairn {
+namespace {
+
+using testing::LoopMission;
+using testing::MakeLoop;
+using testing::OriginError;
+
+// A loop around a yard with walls: five tall faces around the circle (and a level ground that is
+// no landmark), each origin seeing the faces within reach, measured in its own frame.
+struct Wall {
+  Eigen::Vector3d normal, centre;
+};
+const std::vector<Wall> kWalls = {{Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(5.5, 0, 1)},
+                                  {Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 5.5, 1)},
+                                  {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-5.5, 0, 1)},
+                                  {Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -5.5, 1)},
+                                  {Eigen::Vector3d(-0.7071, -0.7071, 0), Eigen::Vector3d(4.2, 4.2, 1)}};
+
+SubmapPlane Seen(const Eigen::Isometry3d& T_w_s, const Wall& w, double sigma) {
+  SubmapPlane p;
+  const Eigen::Vector3d n = T_w_s.linear().transpose() * w.normal.normalized();
+  const Eigen::Vector3d c = T_w_s.inverse() * w.centre;
+  p.normal = n.cast<float>();
+  p.offset = static_cast<float>(-n.dot(c));
+  p.centroid = c.cast<float>();
+  p.covariance = Eigen::Matrix3f::Identity() * static_cast<float>(sigma * sigma);
+  p.min = Eigen::Vector2f(-3.0f, -1.0f);
+  p.max = Eigen::Vector2f(3.0f, 1.0f);
+  p.area = 12.0f;
+  p.points = 2000;
+  return p;
+}
+
+std::shared_ptr<const Submap> WithFaces(const Submap& s, const Eigen::Isometry3d& T_w_s, double reach) {
+  SubmapStructure structure;
+  SubmapPlane ground = Seen(
+      T_w_s,
+      Wall{Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(T_w_s.translation().x(), T_w_s.translation().y(), 0)},
+      0.005);
+  structure.planes.push_back(ground);
+  for (const Wall& w : kWalls) {
+    if ((w.centre - T_w_s.translation()).head<2>().norm() < reach)
+      structure.planes.push_back(Seen(T_w_s, w, 0.005));
+  }
+  return std::make_shared<const Submap>(
+      s.metadata(), s.points(), std::unique_ptr<octomap::OcTree>(new octomap::OcTree(s.tree())), structure);
+}
+
+TEST(PlaneLandmarkStageTest, SharedWallsPullTheLoopTogether) {
+  const LoopMission m = MakeLoop(6);
+  GraphStageOptions go;
+  go.enabled = true;
+  go.pose_every = 1;
+  GraphStage graph(go, /*deterministic=*/true);
+  GraphStage odometry_only(go, /*deterministic=*/true);
+  PlaneLandmarkOptions po;
+  PlaneLandmarkStage stage(po, graph.robot(), "rover");
+  for (const GraphInput& in : m.inputs) {
+    graph.OnInput(in);
+    odometry_only.OnInput(in);
+    if (in.kind == GraphInput::Kind::kFrameSwitch) {
+      const uint64_t done = in.frame_switch.old_frame_id;
+      stage.OnSubmap(graph.robot(), done, *WithFaces(*m.submaps[done], m.T_world_origin[done], 6.5));
+      stage.Step(graph);
+    }
+  }
+  stage.OnSubmap(graph.robot(), m.submaps.size() - 1,
+                 *WithFaces(*m.submaps.back(), m.T_world_origin.back(), 6.5));
+  stage.Step(graph);
+  graph.Finish();
+  odometry_only.Finish();
+
+  const PlaneLandmarkReport r = stage.report();
+  const GraphStageReport g = graph.report();
+  const double with = OriginError(graph, m), without = OriginError(odometry_only, m);
+  std::printf(
+      "[ planes] %llu faces, %llu pairs, %llu associations, %llu observations, %llu landmarks; origin RMSE "
+      "%.3f m with planes, %.3f m without\n",
+      static_cast<unsigned long long>(r.faces), static_cast<unsigned long long>(r.pairs),
+      static_cast<unsigned long long>(r.associations), static_cast<unsigned long long>(r.observations),
+      static_cast<unsigned long long>(g.plane_landmarks), with, without);
+  EXPECT_EQ(r.refused, 0u);
+  EXPECT_EQ(r.waiting, 0u);
+  EXPECT_GE(g.plane_landmarks, 4u);
+  EXPECT_LE(g.plane_landmarks, kWalls.size());  // never two landmarks of one wall here
+  EXPECT_EQ(g.plane_observations, r.observations);
+  EXPECT_LT(with, 0.5 * without);
+
+  // planes.csv: every observation, each row's residual well inside the gate.
+  std::istringstream csv(stage.Csv(graph));
+  std::string line;
+  std::getline(csv, line);
+  size_t rows = 0;
+  while (std::getline(csv, line)) {
+    const double chi2 = std::stod(line.substr(line.rfind(',') + 1));
+    EXPECT_LT(chi2, 11.34) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, r.observations);
+}
+
+TEST(PlaneLandmarkStageTest, TeammatesDecideTheirPairsAndTheirFacesKeepTheirLandmarks) {
+  // Robot 'b' sees that robot 'a' decides pairs with it, and takes a's landmark for its face.
+  PlaneLandmarkStage stage(PlaneLandmarkOptions{}, 'b', "hexa");
+  TeamPlaneObservation o;
+  o.observer = "hexa";
+  o.observer_letter = 'b';
+  o.frame = 3;
+  o.observer_plane = 1;
+  o.creator = "rover";
+  o.creator_letter = 'a';
+  o.creator_frame = 7;
+  o.plane = 2;
+  stage.OnTeamObservations({o, o});
+  EXPECT_EQ(stage.report().team_observations, 1u);
+  GraphStageOptions go;
+  go.enabled = true;
+  GraphStage graph(go, true);
+  const std::string csv = stage.Csv(graph);
+  EXPECT_NE(csv.find("hexa,0,3,1,rover,0,7,2,"), std::string::npos) << csv;
+}
+
+}  // namespace
+}  // namespace cairn
