@@ -528,6 +528,10 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const 
       planes != nullptr && pipeline.graph() != nullptr && options_.matching.plane_landmarks.write_csv) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/planes.csv", planes->Csv(*pipeline.graph())));
   }
+  if (const LineLandmarkStage* lines = pipeline.line_landmarks();
+      lines != nullptr && pipeline.graph() != nullptr && options_.matching.line_landmarks.write_csv) {
+    CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/lines.csv", lines->Csv(*pipeline.graph())));
+  }
   if (pipeline.detection() != nullptr && pipeline.graph() != nullptr && options_.detection.write_csv) {
     CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/detections.csv", FormatDetectionsCsv(pipeline.graph()->detections())));
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <optional>
 
 namespace cairn {
 namespace {
@@ -24,6 +25,27 @@ void WriteStream(JsonWriter& j, std::string_view name, const SensorStreamStats& 
   j.Field("gaps", s.gaps());
   j.Field("out_of_order", s.out_of_order());
   j.Field("duplicates", s.duplicates());
+  j.EndObject();
+}
+
+// What the graph holds of one landmark kind: landmarks, observations, observations waiting.
+struct GraphCounts {
+  uint64_t landmarks = 0, observations = 0, pending = 0;
+};
+
+void WriteStructureLandmarks(JsonWriter& j, const char* name, const char* features,
+                             const StructureLandmarkReport& r, const std::optional<GraphCounts>& g) {
+  j.Key(name).BeginObject();
+  j.Field("submaps", r.submaps).Field(features, r.features).Field("pairs", r.pairs);
+  j.Field("associations", r.associations).Field("observations", r.observations);
+  j.Field("team_observations", r.team_observations).Field("refused", r.refused).Field("waiting", r.waiting);
+  if (g) {
+    j.Field("graph_landmarks", g->landmarks).Field("graph_observations", g->observations);
+    j.Field("graph_pending", g->pending);
+  }
+  j.Key("first_errors").BeginArray();
+  for (const auto& e : r.errors) j.String(e);
+  j.EndArray();
   j.EndObject();
 }
 
@@ -212,22 +234,23 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.EndArray();
     j.EndObject();
   }
+  // Planar faces and straight edges as landmarks: what was compared, paired and what the graph holds.
+  std::optional<GraphStageReport> graph_report;
+  if (const GraphStage* graph = p.graph()) graph_report = graph->report();
   if (const PlaneLandmarkStage* planes = p.plane_landmarks()) {
-    // Planar faces as landmarks: what was compared, paired and what the graph holds.
-    const PlaneLandmarkReport r = planes->report();
-    j.Key("plane_landmarks").BeginObject();
-    j.Field("submaps", r.submaps).Field("faces", r.faces).Field("pairs", r.pairs);
-    j.Field("associations", r.associations).Field("observations", r.observations);
-    j.Field("team_observations", r.team_observations).Field("refused", r.refused).Field("waiting", r.waiting);
-    if (const GraphStage* graph = p.graph()) {
-      const GraphStageReport g = graph->report();
-      j.Field("graph_landmarks", g.plane_landmarks).Field("graph_observations", g.plane_observations);
-      j.Field("graph_pending", g.plane_observations_pending);
-    }
-    j.Key("first_errors").BeginArray();
-    for (const auto& e : r.errors) j.String(e);
-    j.EndArray();
-    j.EndObject();
+    WriteStructureLandmarks(
+        j, "plane_landmarks", "faces", planes->report(),
+        graph_report
+            ? std::optional<GraphCounts>({graph_report->plane_landmarks, graph_report->plane_observations,
+                                          graph_report->plane_observations_pending})
+            : std::nullopt);
+  }
+  if (const LineLandmarkStage* lines = p.line_landmarks()) {
+    WriteStructureLandmarks(j, "line_landmarks", "edges", lines->report(),
+                            graph_report ? std::optional<GraphCounts>(
+                                               {graph_report->line_landmarks, graph_report->line_observations,
+                                                graph_report->line_observations_pending})
+                                         : std::nullopt);
   }
   if (const RobotDetectionStage* detection = p.detection()) {
     // Tag sightings (thesis 6.2): what the detector saw, and what the graph made of them.

@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "estimation/math/tangent_axes.h"
+
 namespace cairn {
 
 struct SubmapPlane {
@@ -26,12 +28,7 @@ struct SubmapPlane {
 
   // In-plane axes: u level (along the plane's intersection with the horizontal, as paper 003's
   // x axis) unless the plane is within about 6 deg of level, where u follows x instead.
-  static void Axes(const Eigen::Vector3f& n, Eigen::Vector3f* u, Eigen::Vector3f* v) {
-    Eigen::Vector3f h = Eigen::Vector3f::UnitZ().cross(n);
-    if (h.squaredNorm() < 0.01f) h = Eigen::Vector3f::UnitX() - n.x() * n;
-    *u = h.normalized();
-    *v = n.cross(*u);
-  }
+  static void Axes(const Eigen::Vector3f& n, Eigen::Vector3f* u, Eigen::Vector3f* v) { TangentAxes(n, u, v); }
 };
 
 }  // namespace cairn

@@ -20,6 +20,7 @@
 #include "mapping/submap_codec.h"
 #include "tools/commands.h"
 #include "tools/sample_median.h"
+#include "tools/submap_truth.h"
 
 namespace cairn::tools {
 namespace {
@@ -76,26 +77,13 @@ struct IndexedSubmap {
 
 // The rows of DIR/submaps/index.csv that have a true pose, with their submap files.
 Status ReadIndexedSubmaps(const std::string& dir, std::vector<IndexedSubmap>* out) {
-  const std::string index = dir + "/submaps/index.csv";
-  std::ifstream in(index);
-  if (!in) return NotFoundError(index + ": cannot open (a cairnd output folder with mapping on?)");
-  std::string line;
-  std::getline(in, line);
-  int row = 1;
-  while (std::getline(in, line)) {
-    ++row;
-    std::vector<std::string> f;
-    std::stringstream fields(line);
-    std::string item;
-    while (std::getline(fields, item, ',')) f.push_back(item);
-    if (f.size() < 7 || f[3].empty()) continue;  // no truth for this origin
-    std::vector<double> v;
-    if (!ParseList(f[3] + "," + f[4] + "," + f[5] + "," + f[6], 4, &v))
-      return InvalidArgumentError(index + ":" + std::to_string(row) + ": bad true pose");
+  std::vector<SubmapTruth> truth;
+  if (Status s = ReadSubmapTruth(dir, &truth); !s.ok()) return s;
+  for (const SubmapTruth& t : truth) {
     IndexedSubmap s;
-    s.robot = f[0];
-    s.id = std::strtoull(f[1].c_str(), nullptr, 10);
-    s.T_world_submap = FourDofTransform(v[0], v[1], v[2], v[3]);
+    s.robot = t.robot;
+    s.id = t.id;
+    s.T_world_submap = t.T_world_submap;
     char name[32];
     std::snprintf(name, sizeof(name), "-%06llu.submap", static_cast<unsigned long long>(s.id));
     auto submap = SubmapCodec::ReadFile(dir + "/submaps/" + s.robot + name);

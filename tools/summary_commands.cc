@@ -18,7 +18,7 @@
 #include "estimation/eval/trajectory.h"
 #include "estimation/eval/trajectory_evaluator.h"
 #include "tools/commands.h"
-#include "tools/plane_landmark_score.h"
+#include "tools/structure_landmark_score.h"
 
 namespace cairn::tools {
 namespace {
@@ -183,21 +183,25 @@ constexpr const char* kSummaryUsage =
 
 namespace {
 
-// Plane landmarks against the simulator's truth, over every robot's observations.
-void PrintPlaneLandmarks(std::span<char* const> dirs) {
+// Plane and line landmarks against the simulator's truth, over every robot's observations.
+void PrintStructureLandmarks(std::span<char* const> dirs, StructureKind kind) {
+  const bool lines = kind == StructureKind::kLine;
+  const char* what = lines ? "line landmarks" : "plane landmarks";
   bool any = false;
-  for (const char* d : dirs) any = any || std::filesystem::exists(std::string(d) + "/planes.csv");
+  for (const char* d : dirs)
+    any = any || std::filesystem::exists(std::string(d) + (lines ? "/lines.csv" : "/planes.csv"));
   if (!any) return;
-  const auto score = ScorePlaneLandmarks(std::vector<std::string>(dirs.begin(), dirs.end()));
+  const auto score = ScoreStructureLandmarks(std::vector<std::string>(dirs.begin(), dirs.end()), kind);
   if (!score.ok()) {
-    std::printf("plane landmarks: %s\n", score.status().message().c_str());
+    std::printf("%s: %s\n", what, score.status().message().c_str());
     return;
   }
-  const PlaneLandmarkScore& s = *score;
+  const StructureLandmarkScore& s = *score;
   std::printf(
-      "plane landmarks: %d landmarks, %d observations; of %d scored against the truth, %d wrong (%d of them "
-      "still inside the gate at the end); right ones within %.1f deg and %.3f m of their first face\n",
-      s.landmarks, s.observations, s.scored, s.wrong, s.wrong_surviving, s.max_angle_deg, s.max_distance);
+      "%s: %d landmarks, %d observations; of %d scored against the truth, %d wrong (%d of them "
+      "still inside the gate at the end); right ones within %.1f deg and %.3f m of their first %s\n",
+      what, s.landmarks, s.observations, s.scored, s.wrong, s.wrong_surviving, s.max_angle_deg,
+      s.max_distance, lines ? "edge" : "face");
 }
 
 }  // namespace
@@ -292,7 +296,8 @@ int RunSummary(const CommandArgs& args) {
     }
   }
   PrintAgreement(views);
-  PrintPlaneLandmarks(args.args);
+  PrintStructureLandmarks(args.args, StructureKind::kPlane);
+  PrintStructureLandmarks(args.args, StructureKind::kLine);
   return rc;
 }
 

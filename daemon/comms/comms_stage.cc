@@ -202,6 +202,14 @@ void CommsStage::PublishPlaneObservations(const std::vector<TeamPlaneObservation
   Push(std::move(o));
 }
 
+void CommsStage::PublishLineObservations(const std::vector<TeamLineObservation>& observations) {
+  if (observations.empty()) return;  // teammates refuse an empty item
+  Outgoing o;
+  o.kind = Outgoing::Kind::kLineObservations;
+  o.lines = observations;
+  Push(std::move(o));
+}
+
 void CommsStage::FinishOwnLog() {
   Outgoing o;
   o.kind = Outgoing::Kind::kFinish;
@@ -243,11 +251,6 @@ void CommsStage::SplitFrame(const std::string& robot, uint64_t* frame, uint32_t*
 void CommsStage::SplitFrames(TeamMatch* m) const {
   SplitFrame(m->robot_a, &m->frame_a, &m->incarnation_a);
   SplitFrame(m->robot_b, &m->frame_b, &m->incarnation_b);
-}
-
-void CommsStage::SplitFrames(TeamPlaneObservation* o) const {
-  SplitFrame(o->observer, &o->frame, &o->observer_incarnation);
-  SplitFrame(o->creator, &o->creator_frame, &o->creator_incarnation);
 }
 
 void CommsStage::FlushPoses() {
@@ -304,8 +307,17 @@ void CommsStage::PublishOwn(Timestamp now, bool flush) {
                 " plane observations of one submap, more than teammates take");
           break;
         }
-        for (TeamPlaneObservation& p : o.planes) SplitFrames(&p);
+        for (TeamPlaneObservation& p : o.planes) SplitObservationFrames(&p);
         Publish(TeamItemKind::kPlaneObservations, TeamItemCodec::PlaneObservations(o.planes));
+        break;
+      case Outgoing::Kind::kLineObservations:
+        if (o.lines.size() > TeamItemCodec::kMaxLineObservations) {
+          Error(std::to_string(o.lines.size()) +
+                " line observations of one submap, more than teammates take");
+          break;
+        }
+        for (TeamLineObservation& l : o.lines) SplitObservationFrames(&l);
+        Publish(TeamItemKind::kLineObservations, TeamItemCodec::LineObservations(o.lines));
         break;
       case Outgoing::Kind::kFinish:
         FlushPoses();

@@ -85,6 +85,7 @@ class CommsStage final : public TeamLink {
   void PublishDetection(const TeamDetection& detection) override;
   void PublishGnssFix(const TeamGnssFix& fix) override;
   void PublishPlaneObservations(const std::vector<TeamPlaneObservation>& observations) override;
+  void PublishLineObservations(const std::vector<TeamLineObservation>& observations) override;
   bool NextInput(TeamInput* input) override;
   void SetNotify(std::function<void()> notify) override;
   void FinishOwnLog() override;
@@ -103,6 +104,7 @@ class CommsStage final : public TeamLink {
       kDetection,
       kGnssFix,
       kPlaneObservations,
+      kLineObservations,
       kFinish
     };
     Kind kind = Kind::kEstimate;
@@ -115,6 +117,7 @@ class CommsStage final : public TeamLink {
     TeamDetection detection;
     TeamGnssFix gnss;
     std::vector<TeamPlaneObservation> planes;
+    std::vector<TeamLineObservation> lines;
   };
 
   explicit CommsStage(const CommsSetup& setup);
@@ -125,7 +128,12 @@ class CommsStage final : public TeamLink {
   void FlushPoses();
   void SplitFrame(const std::string& robot, uint64_t* frame, uint32_t* incarnation) const;
   void SplitFrames(TeamMatch* match) const;
-  void SplitFrames(TeamPlaneObservation* observation) const;
+  // An observation's two frames (its observer's and its creator's) as the wire names them.
+  template <class Observation>
+  void SplitObservationFrames(Observation* o) const {
+    SplitFrame(o->observer, &o->frame, &o->observer_incarnation);
+    SplitFrame(o->creator, &o->creator_frame, &o->creator_incarnation);
+  }
   void Publish(TeamItemKind kind, std::string payload);
   void OnItem(const StoreItem& item);
   void Error(const std::string& what);

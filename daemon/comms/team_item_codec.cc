@@ -62,6 +62,44 @@ void SetPair(const TeamMatch& m, exchange::MatchAttemptItem* out) {
   out->set_frame_b(m.frame_b);
 }
 
+// The robots, runs and frames an observation names (the same fields in both landmark kinds).
+template <class Message, class Observation>
+void SetNames(const Observation& o, Message* p) {
+  p->set_observer(o.observer);
+  p->set_observer_incarnation(o.observer_incarnation);
+  p->set_frame(o.frame);
+  p->set_creator(o.creator);
+  p->set_creator_incarnation(o.creator_incarnation);
+  p->set_creator_frame(o.creator_frame);
+}
+
+template <class Message, class Observation>
+Status GetNames(const Message& p, const TeamItemCodec::Names& names, const std::string& which,
+                Observation* o) {
+  if (p.observer().empty() || p.creator().empty() || p.observer().size() > 64 || p.creator().size() > 64)
+    return DataLossError(which + " names no observer or no creator robot");
+  o->observer = p.observer();
+  o->observer_letter = names.letter_of(o->observer);
+  o->observer_incarnation = p.observer_incarnation();
+  o->frame = names.frame_index(o->observer, p.observer_incarnation(), p.frame());
+  o->creator = p.creator();
+  o->creator_letter = names.letter_of(o->creator);
+  o->creator_incarnation = p.creator_incarnation();
+  o->creator_frame = names.frame_index(o->creator, p.creator_incarnation(), p.creator_frame());
+  return Status::Ok();
+}
+
+// A small covariance sent as doubles: symmetric (relative to its size: the entries are small and
+// were floats before) and positive definite.
+template <int N>
+Status CheckCovariance(const Eigen::Matrix<double, N, N>& c, const std::string& which) {
+  if ((c - c.transpose()).norm() > 1e-6 * c.norm())
+    return DataLossError(which + ": the covariance is not symmetric");
+  if (c.llt().info() != Eigen::Success)
+    return DataLossError(which + ": the covariance is not positive definite");
+  return Status::Ok();
+}
+
 }  // namespace
 
 uint8_t LaneOf(TeamItemKind kind) { return kind == TeamItemKind::kSubmap ? 1 : 0; }
@@ -79,6 +117,8 @@ const char* TeamItemKindName(uint16_t kind) {
       return "gnss_fix";
     case TeamItemKind::kPlaneObservations:
       return "plane_observations";
+    case TeamItemKind::kLineObservations:
+      return "line_observations";
   }
   return "unknown";
 }
@@ -200,12 +240,7 @@ std::string TeamItemCodec::PlaneObservations(const std::vector<TeamPlaneObservat
   exchange::PlaneObservationsItem m;
   for (const TeamPlaneObservation& o : observations) {
     auto* p = m.add_observations();
-    p->set_observer(o.observer);
-    p->set_observer_incarnation(o.observer_incarnation);
-    p->set_frame(o.frame);
-    p->set_creator(o.creator);
-    p->set_creator_incarnation(o.creator_incarnation);
-    p->set_creator_frame(o.creator_frame);
+    SetNames(o, p);
     p->set_plane(o.plane);
     p->set_observer_plane(o.observer_plane);
     p->set_normal_x(o.normal.x());
@@ -217,6 +252,26 @@ std::string TeamItemCodec::PlaneObservations(const std::vector<TeamPlaneObservat
     p->set_centroid_z(o.centroid.z());
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) p->add_covariance(o.covariance(r, c));
+    }
+  }
+  return m.SerializeAsString();
+}
+
+std::string TeamItemCodec::LineObservations(const std::vector<TeamLineObservation>& observations) {
+  exchange::LineObservationsItem m;
+  for (const TeamLineObservation& o : observations) {
+    auto* p = m.add_observations();
+    SetNames(o, p);
+    p->set_line(o.line);
+    p->set_observer_line(o.observer_line);
+    p->set_point_x(o.point.x());
+    p->set_point_y(o.point.y());
+    p->set_point_z(o.point.z());
+    p->set_direction_x(o.direction.x());
+    p->set_direction_y(o.direction.y());
+    p->set_direction_z(o.direction.z());
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) p->add_covariance(o.covariance(r, c));
     }
   }
   return m.SerializeAsString();
@@ -405,9 +460,8 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
       for (size_t k = 0; k < count; ++k) {
         const exchange::PlaneObservation& p = m.observations(static_cast<int>(k));
         const std::string which = what + ": observation " + std::to_string(k);
-        if (p.observer().empty() || p.creator().empty() || p.observer().size() > 64 ||
-            p.creator().size() > 64)
-          return DataLossError(which + " names no observer or no creator robot");
+        TeamPlaneObservation o;
+        CAIRN_RETURN_IF_ERROR(GetNames(p, names, which, &o));
         if (p.plane() > kMaxPlaneIndex || p.observer_plane() > kMaxPlaneIndex)
           return DataLossError(which + ": plane index " +
                                std::to_string(std::max(p.plane(), p.observer_plane())) + " is above " +
@@ -415,15 +469,6 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
         if (p.covariance_size() != 9)
           return DataLossError(which + ": the covariance has " + std::to_string(p.covariance_size()) +
                                " entries, not 9");
-        TeamPlaneObservation o;
-        o.observer = p.observer();
-        o.observer_letter = letter_of(o.observer);
-        o.observer_incarnation = p.observer_incarnation();
-        o.frame = index(o.observer, p.observer_incarnation(), p.frame());
-        o.creator = p.creator();
-        o.creator_letter = letter_of(o.creator);
-        o.creator_incarnation = p.creator_incarnation();
-        o.creator_frame = index(o.creator, p.creator_incarnation(), p.creator_frame());
         o.plane = p.plane();
         o.observer_plane = p.observer_plane();
         o.normal = Eigen::Vector3d(p.normal_x(), p.normal_y(), p.normal_z());
@@ -435,12 +480,44 @@ Expected<TeamInput> TeamItemCodec::Decode(const StoreItem& item, const Names& na
           return DataLossError(which + ": a value is not finite");
         if (std::abs(1.0 - o.normal.norm()) > 1e-3)
           return DataLossError(which + ": the normal is not of unit length");
-        // Relative: plane covariances are small (rad^2, m^2) and were floats before.
-        if ((o.covariance - o.covariance.transpose()).norm() > 1e-6 * o.covariance.norm())
-          return DataLossError(which + ": the covariance is not symmetric");
-        if (o.covariance.llt().info() != Eigen::Success)
-          return DataLossError(which + ": the covariance is not positive definite");
+        CAIRN_RETURN_IF_ERROR(CheckCovariance(o.covariance, which));
         in.planes.push_back(std::move(o));
+      }
+      return in;
+    }
+    case TeamItemKind::kLineObservations: {
+      exchange::LineObservationsItem m;
+      if (!m.ParseFromArray(bytes.data(), size)) return DataLossError(what + ": does not decode");
+      const size_t count = static_cast<size_t>(m.observations_size());
+      if (count == 0) return DataLossError(what + ": has no observations");
+      if (count > kMaxLineObservations)
+        return DataLossError(what + ": has " + std::to_string(count) + " observations, more than " +
+                             std::to_string(kMaxLineObservations));
+      in.kind = TeamInput::Kind::kLineObservations;
+      in.lines.reserve(count);
+      for (size_t k = 0; k < count; ++k) {
+        const exchange::LineObservation& p = m.observations(static_cast<int>(k));
+        const std::string which = what + ": observation " + std::to_string(k);
+        TeamLineObservation o;
+        CAIRN_RETURN_IF_ERROR(GetNames(p, names, which, &o));
+        if (p.line() > kMaxLineIndex || p.observer_line() > kMaxLineIndex)
+          return DataLossError(which + ": line index " +
+                               std::to_string(std::max(p.line(), p.observer_line())) + " is above " +
+                               std::to_string(kMaxLineIndex));
+        if (p.covariance_size() != 16)
+          return DataLossError(which + ": the covariance has " + std::to_string(p.covariance_size()) +
+                               " entries, not 16");
+        o.line = p.line();
+        o.observer_line = p.observer_line();
+        o.point = Eigen::Vector3d(p.point_x(), p.point_y(), p.point_z());
+        o.direction = Eigen::Vector3d(p.direction_x(), p.direction_y(), p.direction_z());
+        for (int i = 0; i < 16; ++i) o.covariance(i / 4, i % 4) = p.covariance(i);
+        if (!o.point.allFinite() || !o.direction.allFinite() || !o.covariance.allFinite())
+          return DataLossError(which + ": a value is not finite");
+        if (std::abs(1.0 - o.direction.norm()) > 1e-3)
+          return DataLossError(which + ": the direction is not of unit length");
+        CAIRN_RETURN_IF_ERROR(CheckCovariance(o.covariance, which));
+        in.lines.push_back(std::move(o));
       }
       return in;
     }

@@ -27,6 +27,7 @@ enum class TeamItemKind : uint16_t {
   kDetection = 7,
   kGnssFix = 8,
   kPlaneObservations = 9,
+  kLineObservations = 10,
 };
 
 // Which lane an item of `kind` travels in (submaps behind the constraints).
@@ -55,6 +56,10 @@ class TeamItemCodec {
   // plane index an observation may name.
   static constexpr size_t kMaxPlaneObservations = 4096;
   static constexpr uint32_t kMaxPlaneIndex = 255;
+  // The same for straight edges.
+  static std::string LineObservations(const std::vector<TeamLineObservation>& observations);
+  static constexpr size_t kMaxLineObservations = 4096;
+  static constexpr uint32_t kMaxLineIndex = 1023;
 
   // How a decoded item names graph variables: a robot's letter (0 for a robot not in the team
   // file) and the index of its frame `frame` of run `incarnation`.

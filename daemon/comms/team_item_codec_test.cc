@@ -384,5 +384,98 @@ TEST(TeamItemCodecTest, PlaneObservationsRefuseWhatATeammateCouldGetWrong) {
   }
 }
 
+std::vector<TeamLineObservation> LineObservations() {
+  // Submap 6 of hexa's run 1: an edge it creates a landmark with, and one that re-observes rover1's.
+  TeamLineObservation own;
+  own.observer = "hexa";
+  own.observer_incarnation = 1;
+  own.frame = 6;
+  own.creator = "hexa";
+  own.creator_incarnation = 1;
+  own.creator_frame = 6;
+  own.line = 17;
+  own.observer_line = 17;
+  own.point = Eigen::Vector3d(3.0, -1.0, 0.4);
+  own.direction = Eigen::Vector3d(0.0, 0.6, 0.8);
+  own.covariance = Eigen::Vector4d(1e-4, 2e-4, 4e-4, 9e-4).asDiagonal();
+  own.covariance(0, 2) = own.covariance(2, 0) = 5e-5;
+  TeamLineObservation seen = own;
+  seen.creator = "rover1";
+  seen.creator_incarnation = 0;
+  seen.creator_frame = 11;
+  seen.line = 1023;
+  seen.observer_line = 2;
+  seen.direction = Eigen::Vector3d(1.0, 0.0, 0.0);
+  return {own, seen};
+}
+
+TEST(TeamItemCodecTest, LineObservationsNameTheirRobotsRunsAndFrames) {
+  EXPECT_EQ(LaneOf(TeamItemKind::kLineObservations), LaneOf(TeamItemKind::kMatch));
+  const std::vector<TeamLineObservation> sent = LineObservations();
+  auto in = TeamItemCodec::Decode(
+      Item("hexa", TeamItemKind::kLineObservations, TeamItemCodec::LineObservations(sent)), TestNames());
+  ASSERT_TRUE(in.ok()) << in.status().ToString();
+  EXPECT_EQ(in->kind, TeamInput::Kind::kLineObservations);
+  ASSERT_EQ(in->lines.size(), 2u);
+  const char creator_letters[2] = {'b', 'a'};
+  const uint64_t creator_frames[2] = {(uint64_t{1} << 40) | 6, 11};
+  for (size_t k = 0; k < 2; ++k) {
+    SCOPED_TRACE(k);
+    const TeamLineObservation& got = in->lines[k];
+    const TeamLineObservation& want = sent[k];
+    EXPECT_EQ(got.observer_letter, 'b');
+    EXPECT_EQ(got.frame, (uint64_t{1} << 40) | 6);
+    EXPECT_EQ(got.creator, want.creator);
+    EXPECT_EQ(got.creator_letter, creator_letters[k]);
+    EXPECT_EQ(got.creator_frame, creator_frames[k]);
+    EXPECT_EQ(got.line, want.line);
+    EXPECT_EQ(got.observer_line, want.observer_line);
+    EXPECT_EQ(got.point, want.point);
+    EXPECT_EQ(got.direction, want.direction);
+    EXPECT_EQ(got.covariance, want.covariance);
+  }
+}
+
+TEST(TeamItemCodecTest, LineObservationsRefuseWhatATeammateCouldGetWrong) {
+  const auto refused = [](const std::vector<TeamLineObservation>& bad) {
+    auto out = TeamItemCodec::Decode(
+        Item("hexa", TeamItemKind::kLineObservations, TeamItemCodec::LineObservations(bad)), TestNames());
+    return out.ok() ? std::string() : out.status().ToString();
+  };
+  const std::vector<TeamLineObservation> good = LineObservations();
+  ASSERT_EQ(refused(good), "");
+  const auto with = [&](const std::function<void(TeamLineObservation*)>& spoil) {
+    std::vector<TeamLineObservation> bad = good;
+    spoil(&bad[1]);
+    return refused(bad);
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(refused({}).find("line_observations"), std::string::npos) << refused({});
+  const std::vector<TeamLineObservation> many(TeamItemCodec::kMaxLineObservations + 1, good[0]);
+  EXPECT_NE(refused(many).find("4097 observations"), std::string::npos) << refused(many);
+  std::string why = with([&](TeamLineObservation* o) { o->point.y() = nan; });
+  EXPECT_NE(why.find("observation 1: a value is not finite"), std::string::npos) << why;
+  why = with([&](TeamLineObservation* o) { o->covariance(3, 1) = nan; });
+  EXPECT_NE(why.find("a value is not finite"), std::string::npos) << why;
+  why = with([](TeamLineObservation* o) { o->direction *= 1.002; });
+  EXPECT_NE(why.find("direction is not of unit length"), std::string::npos) << why;
+  why = with([](TeamLineObservation* o) { o->covariance(0, 3) += 1e-6; });
+  EXPECT_NE(why.find("not symmetric"), std::string::npos) << why;
+  why = with([](TeamLineObservation* o) { o->covariance(3, 3) = -1e-3; });
+  EXPECT_NE(why.find("not positive definite"), std::string::npos) << why;
+  why = with([](TeamLineObservation* o) { o->line = 1024; });
+  EXPECT_NE(why.find("line index 1024"), std::string::npos) << why;
+  why = with([](TeamLineObservation* o) { o->creator.clear(); });
+  EXPECT_NE(why.find("no creator"), std::string::npos) << why;
+  exchange::LineObservationsItem m;
+  m.ParseFromString(TeamItemCodec::LineObservations(good));
+  m.mutable_observations(0)->mutable_covariance()->RemoveLast();
+  auto out = TeamItemCodec::Decode(Item("hexa", TeamItemKind::kLineObservations, m.SerializeAsString()),
+                                   TestNames());
+  ASSERT_FALSE(out.ok());
+  EXPECT_NE(out.status().ToString().find("has 15 entries, not 16"), std::string::npos)
+      << out.status().ToString();
+}
+
 }  // namespace
 }  // namespace cairn

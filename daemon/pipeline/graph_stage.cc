@@ -10,6 +10,7 @@
 #include "common/heap_bytes.h"
 #include "common/monotonic_clock.h"
 #include "detection/gravity_agreement.h"
+#include "estimation/graph/line_factors.h"
 #include "estimation/graph/plane_factors.h"
 
 namespace cairn {
@@ -259,6 +260,10 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       for (const TeamPlaneObservation& o : in.planes) pending_planes_.push_back(o);
       break;
     }
+    case TeamInput::Kind::kLineObservations: {
+      for (const TeamLineObservation& o : in.lines) pending_lines_.push_back(o);
+      break;
+    }
     case TeamInput::Kind::kMatch: {
       if (in.match.letter_a == 0 || in.match.letter_b == 0) break;  // a robot not in the team file
       pending_matches_.push_back(PendingMatch{in.match.letter_a, in.match.letter_b, in.match.frame_a, in.match.frame_b,
@@ -270,6 +275,7 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
   }
   RetryPendingMatches();
   RetryPendingPlanes();
+  RetryPendingLines();
   // New estimates of a teammate, or a tie to its subgraph, may place its waiting fixes.
   if (!pending_fixes_.empty() && in.kind != TeamInput::Kind::kGnssFix) RetryPendingFixes();
   Update();
@@ -282,71 +288,132 @@ uint64_t PlaneLandmarkKey(char letter, uint64_t frame, uint32_t plane) {
                      (static_cast<uint64_t>(RunOfIndex(frame)) << kRunShift) | local);
 }
 
-Status GraphStage::AddPlaneObservation(const TeamPlaneObservation& o) {
-  if (o.observer_letter == 0 || o.creator_letter == 0) {
-    return InvalidArgumentError("plane observation naming a robot not in the team");
-  }
-  if (o.plane > 255 || o.observer_plane > 255)
-    return InvalidArgumentError("plane observation: plane index above 255");
-  const uint64_t s = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
-  const uint64_t l = PlaneLandmarkKey(o.creator_letter, o.creator_frame, o.plane);
-  if (plane_factors_.count({s, l}) != 0) return AlreadyExistsError("plane observation held already");
-  const std::vector<uint64_t> loose = graph_.Unconnected();
-  if (!graph_.HasVariable(s) || std::find(loose.begin(), loose.end(), s) != loose.end()) {
-    return NotFoundError(std::string("plane observation by origin ") + o.observer_letter +
-                         std::to_string(o.frame) + ": not tied to this robot's origins yet");
-  }
-  const Eigen::LLT<Eigen::Matrix3d> llt(o.covariance);
-  if (!o.normal.allFinite() || !std::isfinite(o.offset) || !o.centroid.allFinite() ||
-      !o.covariance.allFinite() || llt.info() != Eigen::Success || std::abs(o.normal.norm() - 1.0) > 1e-3) {
-    return InvalidArgumentError(
-        "plane observation with a non-finite plane, a normal not of unit length or a "
-        "covariance not positive definite");
-  }
-  const bool new_landmark = !graph_.HasVariable(l);
+uint64_t LineLandmarkKey(char letter, uint64_t frame, uint32_t line) {
+  const uint64_t local = ((LocalIndex(frame) << 10) | (line & 0x3ffu)) & ((uint64_t{1} << kRunShift) - 1);
+  return VariableKey(VariableKind::kLine, letter,
+                     (static_cast<uint64_t>(RunOfIndex(frame)) << kRunShift) | local);
+}
+
+SlamFactor GraphStage::PlaneFactor(const TeamPlaneObservation& o) {
   SlamFactor f;
   f.kind = FactorKind::kPlaneObservation;
-  f.a = s;
-  f.b = l;
+  f.a = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
+  f.b = PlaneLandmarkKey(o.creator_letter, o.creator_frame, o.plane);
   const Eigen::Vector3d n = o.normal.normalized();
   f.plane = Eigen::Vector4d(n.x(), n.y(), n.z(), o.offset);
   f.plane_information = o.covariance.inverse();
   f.plane_information = 0.5 * (f.plane_information + f.plane_information.transpose());
   // Where a new landmark starts: the face's centroid, moved onto the plane.
   f.z = PlaneLandmarkFrame(n, o.centroid - (n.dot(o.centroid) + o.offset) * n);
+  return f;
+}
+
+SlamFactor GraphStage::LineFactor(const TeamLineObservation& o) {
+  SlamFactor f;
+  f.kind = FactorKind::kLineObservation;
+  f.a = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
+  f.b = LineLandmarkKey(o.creator_letter, o.creator_frame, o.line);
+  f.line_point = o.point;
+  f.line_direction = o.direction.normalized();
+  f.line_information = o.covariance.inverse();
+  f.line_information = 0.5 * (f.line_information + f.line_information.transpose());
+  f.z = LineLandmarkFrame(f.line_direction, o.point);  // where a new landmark starts
+  return f;
+}
+
+Status GraphStage::AddStructureFactor(const SlamFactor& f, char observer, uint64_t frame, bool* created) {
+  const char* what = f.kind == FactorKind::kPlaneObservation ? "plane" : "line";
+  if (structure_factors_.count({f.a, f.b}) != 0) {
+    return AlreadyExistsError(std::string(what) + " observation held already");
+  }
+  if (!graph_.Tied(f.a)) {
+    return NotFoundError(std::string(what) + " observation by origin " + observer + std::to_string(frame) +
+                         ": not tied to this robot's origins yet");
+  }
+  *created = !graph_.HasVariable(f.b);
   const size_t errors = report_.errors.size();
   if (!Add(f)) {
     return InvalidArgumentError(report_.errors.size() > errors ? report_.errors.back()
                                                                : "the graph refused it");
   }
-  plane_factors_.insert({s, l});
-  ++report_.plane_observations;
-  if (new_landmark) ++report_.plane_landmarks;
-  Update();
+  structure_factors_.insert({f.a, f.b});
   return Status::Ok();
 }
 
+std::vector<Status> GraphStage::AddPlaneObservations(const std::vector<TeamPlaneObservation>& observations) {
+  std::vector<Status> out;
+  out.reserve(observations.size());
+  bool added = false;
+  for (const TeamPlaneObservation& o : observations) {
+    out.push_back(AddPlaneObservationNoUpdate(o));
+    added = added || out.back().ok();
+  }
+  if (added) Update();
+  return out;
+}
+
+std::vector<Status> GraphStage::AddLineObservations(const std::vector<TeamLineObservation>& observations) {
+  std::vector<Status> out;
+  out.reserve(observations.size());
+  bool added = false;
+  for (const TeamLineObservation& o : observations) {
+    out.push_back(AddLineObservationNoUpdate(o));
+    added = added || out.back().ok();
+  }
+  if (added) Update();
+  return out;
+}
+
+// The graph checks the measurement and its covariance (the codec has checked teammates' already).
+Status GraphStage::AddPlaneObservationNoUpdate(const TeamPlaneObservation& o) {
+  if (o.observer_letter == 0 || o.creator_letter == 0) {
+    return InvalidArgumentError("plane observation naming a robot not in the team");
+  }
+  if (o.plane > 255 || o.observer_plane > 255)
+    return InvalidArgumentError("plane observation: plane index above 255");
+  bool created = false;
+  const Status s = AddStructureFactor(PlaneFactor(o), o.observer_letter, o.frame, &created);
+  if (s.ok()) {
+    ++report_.plane_observations;
+    if (created) ++report_.plane_landmarks;
+  }
+  return s;
+}
+
+Status GraphStage::AddLineObservationNoUpdate(const TeamLineObservation& o) {
+  if (o.observer_letter == 0 || o.creator_letter == 0) {
+    return InvalidArgumentError("line observation naming a robot not in the team");
+  }
+  if (o.line > 1023 || o.observer_line > 1023)
+    return InvalidArgumentError("line observation: line index above 1023");
+  bool created = false;
+  const Status s = AddStructureFactor(LineFactor(o), o.observer_letter, o.frame, &created);
+  if (s.ok()) {
+    ++report_.line_observations;
+    if (created) ++report_.line_landmarks;
+  }
+  return s;
+}
+
 Expected<double> GraphStage::PlaneObservationChi2(const TeamPlaneObservation& o) const {
-  const uint64_t s = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
-  const uint64_t l = PlaneLandmarkKey(o.creator_letter, o.creator_frame, o.plane);
-  if (plane_factors_.count({s, l}) == 0) return NotFoundError("plane observation not in the graph");
-  const Eigen::Vector3d n = o.normal.normalized();
-  const Eigen::Matrix3d information = o.covariance.inverse();
-  const Eigen::Vector3d e =
-      PlaneObservationResidual(Eigen::Vector4d(n.x(), n.y(), n.z(), o.offset), information)
-          .Error(*graph_.Pose(s), *graph_.Pose(l));
-  return e.dot(information * e);
+  const SlamFactor f = PlaneFactor(o);
+  if (structure_factors_.count({f.a, f.b}) == 0) return NotFoundError("plane observation not in the graph");
+  return graph_.FactorChi2(f);
+}
+
+Expected<double> GraphStage::LineObservationChi2(const TeamLineObservation& o) const {
+  const SlamFactor f = LineFactor(o);
+  if (structure_factors_.count({f.a, f.b}) == 0) return NotFoundError("line observation not in the graph");
+  return graph_.FactorChi2(f);
 }
 
 bool GraphStage::PlaceOrigins(const std::vector<std::pair<char, uint64_t>>& origins,
                               std::vector<SubmapPlacement>* out, std::string* why) {
   out->clear();
   std::vector<uint64_t> keys;
-  const std::vector<uint64_t> unconnected = graph_.Unconnected();
-  const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
   for (const auto& [letter, frame] : origins) {
     const uint64_t key = VariableKey(VariableKind::kSubmap, letter, frame);
-    if (!graph_.HasVariable(key) || loose.count(key) != 0) {
+    if (!graph_.Tied(key)) {
       *why = std::string("origin ") + letter + std::to_string(frame) + " not tied to this robot's";
       return false;
     }
@@ -362,27 +429,42 @@ bool GraphStage::PlaceOrigins(const std::vector<std::pair<char, uint64_t>>& orig
   return true;
 }
 
-void GraphStage::RetryPendingPlanes() {
-  if (pending_planes_.empty()) return;
-  // Retried at every teammate's item while their submaps float: one look at the graph for all.
-  const std::vector<uint64_t> unconnected = graph_.Unconnected();
-  const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
-  for (size_t i = 0; i < pending_planes_.size();) {
-    const TeamPlaneObservation& o = pending_planes_[i];
+namespace {
+
+// Teammates' observations whose submaps the graph now ties to this robot's are added; the others
+// wait. Only after a teammate's item, which updates the graph next.
+template <class Observation, class AddFn>
+void RetryPendingStructure(std::vector<Observation>& pending, const SlamGraph& graph, uint64_t* added,
+                           AddFn add) {
+  for (size_t i = 0; i < pending.size();) {
+    const Observation& o = pending[i];
     const uint64_t origin = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
-    if (o.observer_letter != 0 && (!graph_.HasVariable(origin) || loose.count(origin) != 0)) {
+    if (o.observer_letter != 0 && !graph.Tied(origin)) {
       ++i;
       continue;
     }
-    const Status s = AddPlaneObservation(o);
+    const Status s = add(o);
     if (s.code() == StatusCode::kNotFound) {
       ++i;
       continue;
     }
-    if (s.ok()) ++report_.team_factors;
-    pending_planes_.erase(pending_planes_.begin() + static_cast<long>(i));
+    if (s.ok()) ++*added;
+    pending.erase(pending.begin() + static_cast<long>(i));
   }
+}
+
+}  // namespace
+
+void GraphStage::RetryPendingPlanes() {
+  RetryPendingStructure(pending_planes_, graph_, &report_.team_factors,
+                        [this](const TeamPlaneObservation& o) { return AddPlaneObservationNoUpdate(o); });
   report_.plane_observations_pending = pending_planes_.size();
+}
+
+void GraphStage::RetryPendingLines() {
+  RetryPendingStructure(pending_lines_, graph_, &report_.team_factors,
+                        [this](const TeamLineObservation& o) { return AddLineObservationNoUpdate(o); });
+  report_.line_observations_pending = pending_lines_.size();
 }
 
 void GraphStage::RetryPendingMatches() {
@@ -881,7 +963,7 @@ GraphScene GraphStage::Scene(bool covariances) {
   };
   for (uint64_t key : graph_.VariableKeys()) {
     if (loose.count(key) != 0) continue;  // where the graph cannot place it yet: not drawn
-    if (KindOfKey(key) == VariableKind::kDatum || KindOfKey(key) == VariableKind::kPlane) continue;
+    if (KindOfKey(key) == VariableKind::kDatum || IsStructureVariable(key)) continue;
     auto p = graph_.Pose(key);
     if (!p.ok()) continue;
     GraphScene::Node node{key, ToIsometry(*p), Eigen::Matrix3d::Zero(), ""};
@@ -928,8 +1010,8 @@ GraphScene GraphStage::Scene(bool covariances) {
 PoseGraph GraphStage::ExportPoseGraph() const {
   PoseGraph g;
   for (uint64_t key : graph_.VariableKeys()) {
-    // The datum and the planes have no pose edges (their factors are not g2o's).
-    if (KindOfKey(key) == VariableKind::kDatum || KindOfKey(key) == VariableKind::kPlane) continue;
+    // The datum and the planes and lines have no pose edges (their factors are not g2o's).
+    if (KindOfKey(key) == VariableKind::kDatum || IsStructureVariable(key)) continue;
     if (auto p = graph_.Pose(key); p.ok()) g.SetVertex(key, *p);
   }
   g.set_has_initial_estimate(true);

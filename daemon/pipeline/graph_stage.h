@@ -46,6 +46,9 @@ struct GraphStageReport {
   uint64_t plane_landmarks = 0;       // plane landmarks l started
   uint64_t plane_observations = 0;    // their observations o added (own and teammates')
   uint64_t plane_observations_pending = 0;  // a teammate's, its submap not tied to this robot's yet
+  uint64_t line_landmarks = 0;              // line landmarks l started
+  uint64_t line_observations = 0;           // their observations o added (own and teammates')
+  uint64_t line_observations_pending = 0;   // a teammate's, its submap not tied to this robot's yet
   uint64_t detections = 0;            // robot detections d added (own and teammates')
   uint64_t landmark_observations = 0; // landmark observations o added
   uint64_t detections_pending = 0;    // waiting for a robot's estimates around their time
@@ -91,6 +94,8 @@ struct OriginEstimate {
 // The graph key of the plane landmark named by its first observation: plane `plane` of the
 // submap at graph frame index `frame` of robot `letter`.
 uint64_t PlaneLandmarkKey(char letter, uint64_t frame, uint32_t plane);
+// The same for the line landmark named by edge `line` (< 1024) of a submap.
+uint64_t LineLandmarkKey(char letter, uint64_t frame, uint32_t line);
 
 class GraphStage {
  public:
@@ -125,13 +130,17 @@ class GraphStage {
   const Eigen::Vector3d& gnss_antenna() const { return gnss_.antenna(); }
   // T_world_enu of the GNSS datum; false before fixes have started it.
   bool Datum(Eigen::Isometry3d* T_world_enu) const;
-  // A plane landmark observation o (this robot's or a teammate's, by graph letters and frame
+  // Plane landmark observations o (this robot's or a teammate's, by graph letters and frame
   // indices). NotFound while the observing submap is not in the graph or not tied to this robot's
   // (a teammate's: it waits and is retried); AlreadyExists for one the graph holds; other errors
   // for what the graph refused.
-  Status AddPlaneObservation(const TeamPlaneObservation& observation);
+  // One status per observation; the graph updates once after them all.
+  std::vector<Status> AddPlaneObservations(const std::vector<TeamPlaneObservation>& observations);
   // The squared Mahalanobis residual of an observation the graph holds, at the current estimate.
   Expected<double> PlaneObservationChi2(const TeamPlaneObservation& observation) const;
+  // Line landmark observations o, as AddPlaneObservations.
+  std::vector<Status> AddLineObservations(const std::vector<TeamLineObservation>& observations);
+  Expected<double> LineObservationChi2(const TeamLineObservation& observation) const;
   // The origins (graph letter, frame index) with their marginal covariances; false, with the
   // reason, when one is not in the graph, not tied to this robot's, or the covariances fail.
   bool PlaceOrigins(const std::vector<std::pair<char, uint64_t>>& origins, std::vector<SubmapPlacement>* out,
@@ -197,6 +206,13 @@ class GraphStage {
   void OnFrameSwitch(const FrameSwitchEvent& e);
   bool Add(const SlamFactor& f);
   void Update();
+  static SlamFactor PlaneFactor(const TeamPlaneObservation& o);
+  static SlamFactor LineFactor(const TeamLineObservation& o);
+  Status AddPlaneObservationNoUpdate(const TeamPlaneObservation& o);
+  Status AddLineObservationNoUpdate(const TeamLineObservation& o);
+  // The checks and bookkeeping both landmark kinds share; `*created` when the factor starts its
+  // landmark.
+  Status AddStructureFactor(const SlamFactor& f, char observer, uint64_t frame, bool* created);
   void Error(const std::string& what);
   Matrix6d Floored(const Matrix6d& covariance) const;
   uint64_t OriginKey(uint64_t frame_id) const;
@@ -230,8 +246,10 @@ class GraphStage {
   std::vector<PendingMatch> pending_matches_;
   void RetryPendingMatches();
   std::vector<TeamPlaneObservation> pending_planes_;
-  std::set<std::pair<uint64_t, uint64_t>> plane_factors_;  // (origin, landmark) held
+  std::set<std::pair<uint64_t, uint64_t>> structure_factors_;  // (origin, landmark) held
   void RetryPendingPlanes();
+  std::vector<TeamLineObservation> pending_lines_;
+  void RetryPendingLines();
   // Detections.
   struct PoseCovariance {
     Timestamp time;

@@ -146,6 +146,9 @@ Status Pipeline::EnableMatching(const SubmapMatchingOptions& options, const std:
   if (options.plane_landmarks.enabled) {
     planes_ = std::make_unique<PlaneLandmarkStage>(options.plane_landmarks, graph_->robot(), robot);
   }
+  if (options.line_landmarks.enabled) {
+    lines_ = std::make_unique<LineLandmarkStage>(options.line_landmarks, graph_->robot(), robot);
+  }
   mapping_->PublishSubmapsTo(&submap_queue_);
   return Status::Ok();
 }
@@ -156,6 +159,7 @@ Status Pipeline::SetTeamLink(TeamLink* team, std::map<char, std::string> names) 
   team_ = team;
   for (const auto& [letter, name] : names) letters_[name] = letter;
   if (planes_) planes_->SetTeam(names, team);
+  if (lines_) lines_->SetTeam(names, team);
   if (matching_) matching_->SetTeam(std::move(names), team);
   team_->SetNotify([this] { graph_signal_.Notify(); });
   // Finished submaps travel to the team even without the matcher.
@@ -248,6 +252,7 @@ void Pipeline::StopAndDrain() {
       TakeSubmaps(UINT64_MAX);
       matching_->Drain(*graph_);
       if (planes_) planes_->Step(*graph_);
+      if (lines_) lines_->Step(*graph_);
     }
     graph_->Finish();  // waits for a running full solve, so its worker stops after it
     graph_full_solve_exec_.RequestStop();
@@ -512,14 +517,16 @@ void Pipeline::TakeMappingInputs() {
 
 void Pipeline::StepSubmapWork() {
   if (matching_) matching_->Step(*graph_);
-  // After the matcher: its matches tie teammates' origins, which places their faces.
+  // After the matcher: its matches tie teammates' origins, which places their faces and edges.
   if (planes_) planes_->Step(*graph_);
+  if (lines_) lines_->Step(*graph_);
 }
 
 void Pipeline::TakeSubmaps(uint64_t max_id) {
   while (const std::shared_ptr<const Submap>* s = submap_queue_.Front()) {
     if ((*s)->metadata().id > max_id) return;
     if (planes_) planes_->OnSubmap(graph_->robot(), (*s)->metadata().id, **s);
+    if (lines_) lines_->OnSubmap(graph_->robot(), (*s)->metadata().id, **s);
     if (matching_) matching_->OnSubmap(*s);
     if (team_) team_->PublishSubmap(*s);
     submap_queue_.PopFront();
@@ -546,8 +553,10 @@ bool Pipeline::TakeTeamInputs() {
       team_submaps_[in.letter][in.new_frame] = in.submap;
       if (matching_) matching_->OnTeamSubmap(in.robot, in.new_frame, in.submap);
       if (planes_) planes_->OnSubmap(in.letter, in.new_frame, *in.submap);
+      if (lines_) lines_->OnSubmap(in.letter, in.new_frame, *in.submap);
     }
     if (planes_ && in.kind == TeamInput::Kind::kPlaneObservations) planes_->OnTeamObservations(in.planes);
+    if (lines_ && in.kind == TeamInput::Kind::kLineObservations) lines_->OnTeamObservations(in.lines);
     if (matching_ && (in.kind == TeamInput::Kind::kAttempt || in.kind == TeamInput::Kind::kMatch)) {
       matching_->OnTeamAttempt(in.match, in.kind == TeamInput::Kind::kMatch || in.matched);
     }

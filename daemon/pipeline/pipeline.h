@@ -20,12 +20,12 @@
 #include "daemon/pipeline/graph_stage.h"
 #include "daemon/pipeline/latency_histogram.h"
 #include "daemon/pipeline/mapping_stage.h"
-#include "daemon/pipeline/plane_landmark_stage.h"
 #include "daemon/pipeline/queued.h"
 #include "daemon/pipeline/robot_detection_stage.h"
 #include "daemon/pipeline/sensor_stream_stats.h"
 #include "daemon/pipeline/spsc_queue.h"
 #include "daemon/pipeline/stereo_rectify_stage.h"
+#include "daemon/pipeline/structure_landmark_stage.h"
 #include "daemon/pipeline/submap_matching_stage.h"
 #include "daemon/pipeline/team_link.h"
 #include "daemon/pipeline/telemetry_stage.h"
@@ -180,6 +180,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   const SubmapMatchingStage* matching() const { return matching_.get(); }
   // Valid after StopAndDrain(); null when plane landmarks are not enabled.
   const PlaneLandmarkStage* plane_landmarks() const { return planes_.get(); }
+  const LineLandmarkStage* line_landmarks() const { return lines_.get(); }
   FaultReport fault_report() const;
 
   // Live progress (any thread).
@@ -291,6 +292,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   std::unique_ptr<GraphStage> graph_;
   std::unique_ptr<SubmapMatchingStage> matching_;
   std::unique_ptr<PlaneLandmarkStage> planes_;
+  std::unique_ptr<LineLandmarkStage> lines_;
   // The submaps' comparisons (matcher, plane landmarks) at a fixed point of the graph's input.
   void StepSubmapWork();
   std::unique_ptr<RobotDetectionStage> detection_;

@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "common/options_visitor.h"
-#include "daemon/pipeline/plane_landmark_options.h"
+#include "daemon/pipeline/structure_landmark_options.h"
 #include "mapping/matching/submap_feature_extractor.h"
 #include "mapping/matching/submap_matcher.h"
 #include "mapping/matching/submap_pairing.h"
@@ -28,6 +28,7 @@ struct SubmapMatchingOptions {
   SubmapPairingOptions pairing;
   SubmapMatcherOptions matcher;
   PlaneLandmarkOptions plane_landmarks;
+  LineLandmarkOptions line_landmarks;
 
   void Visit(OptionsVisitor& v) {
     v.Flag("enabled", enabled);
@@ -40,6 +41,7 @@ struct SubmapMatchingOptions {
     v.Section("pairing", pairing);
     v.Section("matcher", matcher);
     v.Section("plane_landmarks", plane_landmarks);
+    v.Section("line_landmarks", line_landmarks);
   }
 };
 

@@ -113,6 +113,26 @@ struct TeamPlaneObservation {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // rad, rad, m
 };
 
+// A line landmark observation o, as TeamPlaneObservation for straight edges: edge `observer_line`
+// of the submap, the line through `point` (the edge's middle, in the submap's gravity-aligned
+// frame) along unit `direction`, with `covariance` that of line_factors.h's error (rad, rad, m,
+// m); the landmark is named by edge `line` of `creator`'s submap `creator_frame`.
+struct TeamLineObservation {
+  std::string observer;
+  char observer_letter = 0;
+  uint32_t observer_incarnation = 0;
+  uint64_t frame = 0;
+  uint32_t observer_line = 0;
+  std::string creator;
+  char creator_letter = 0;
+  uint32_t creator_incarnation = 0;
+  uint64_t creator_frame = 0;
+  uint32_t line = 0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Identity();
+};
+
 struct TeamInput {
   enum class Kind : uint8_t {
     kRunStart,
@@ -123,7 +143,8 @@ struct TeamInput {
     kAttempt,
     kDetection,
     kGnssFix,
-    kPlaneObservations
+    kPlaneObservations,
+    kLineObservations
   };
   Kind kind = Kind::kRunStart;
   std::string robot;   // the item's origin
@@ -150,6 +171,8 @@ struct TeamInput {
   TeamGnssFix gnss;
   // kPlaneObservations: one robot's decisions for one of its submaps
   std::vector<TeamPlaneObservation> planes;
+  // kLineObservations: the same for straight edges
+  std::vector<TeamLineObservation> lines;
 };
 
 }  // namespace cairn

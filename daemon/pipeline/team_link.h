@@ -29,6 +29,8 @@ class TeamLink {
   // Plane landmark observations: one robot's decisions for one of its submaps (graph frame
   // indices, as the graph names them).
   virtual void PublishPlaneObservations(const std::vector<TeamPlaneObservation>& observations) = 0;
+  // The same for line landmarks.
+  virtual void PublishLineObservations(const std::vector<TeamLineObservation>& observations) = 0;
   // Teammates' items not taken yet; false when there are none.
   virtual bool NextInput(TeamInput* input) = 0;
   // Called (from the comms thread) when inputs arrive, to wake the graph thread.

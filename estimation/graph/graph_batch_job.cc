@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 
 #include "estimation/graph/chordal_initializer.h"
+#include "estimation/graph/line_factors.h"
 #include "estimation/graph/plane_factors.h"
 #include "estimation/graph/pose_factors.h"
 
@@ -58,11 +59,11 @@ Status InitializeSnapshotChordal(GraphSnapshot& s) {
   }
   CAIRN_RETURN_IF_ERROR(InitializeChordal(g));
   for (size_t i = 0; i < g.num_vertices(); ++i) s.poses[index(g.ids()[i])] = g.poses()[i];
-  // Plane landmarks are no vertices of the pose graph: each goes back onto the plane as the submap
-  // that created it (its first observation) now sees it.
+  // Plane and line landmarks are no vertices of the pose graph: each goes back onto its plane or
+  // line as the submap that created it (its first observation) now sees it.
   std::set<uint64_t> placed;
   for (const auto& f : s.factors) {
-    if (f.kind == FactorKind::kPlaneObservation && placed.insert(f.b).second) {
+    if (IsStructureObservation(f.kind) && placed.insert(f.b).second) {
       s.poses[index(f.b)] = s.poses[index(f.a)] * f.z;
     }
   }
@@ -87,6 +88,7 @@ void GraphBatchJob::Run() {
   ceres::Problem problem(po);
   const auto manifold = MakePoseManifold();
   const auto plane_manifold = MakePlaneLandmarkManifold();
+  const auto line_manifold = MakeLineLandmarkManifold();
   ceres::CauchyLoss cauchy(cauchy_c_ > 0.0 ? cauchy_c_ : 1.0);
   auto block = [&](uint64_t key) {
     return &blocks[7 * static_cast<size_t>(std::lower_bound(s.keys.begin(), s.keys.end(), key) - s.keys.begin())];
@@ -102,7 +104,10 @@ void GraphBatchJob::Run() {
   for (size_t i = 0; i < n; ++i) {
     double* b = &blocks[7 * i];
     if (!problem.HasParameterBlock(b)) continue;
-    problem.SetManifold(b, IsPlaneVariable(s.keys[i]) ? plane_manifold.get() : manifold.get());
+    const int tangent = TangentSizeOf(s.keys[i]);
+    problem.SetManifold(b, tangent == 3   ? plane_manifold.get()
+                           : tangent == 4 ? line_manifold.get()
+                                          : manifold.get());
     if (s.constant[i]) problem.SetParameterBlockConstant(b);
   }
   stats_ = SolveGraphProblem(problem, static_cast<int>(iterations_), 1e9);

@@ -27,9 +27,6 @@ std::unique_ptr<ceres::Manifold> MakePlaneLandmarkManifold();
 // where the plane is not, as SubmapPlane's u axis).
 Pose3 PlaneLandmarkFrame(const Eigen::Vector3d& normal, const Eigen::Vector3d& point);
 
-// SubmapPlane's tangent axes in double precision.
-void PlaneTangentAxes(const Eigen::Vector3d& n, Eigen::Vector3d* u, Eigen::Vector3d* v);
-
 class PlaneObservationResidual {
  public:
   // `plane` = (n, d) measured in the submap's frame; `information` of (a, b, d).

@@ -9,6 +9,7 @@
 #include "estimation/graph/slam_graph.h"
 #include "estimation/math/ordered_draws.h"
 #include "estimation/math/so3.h"
+#include "estimation/math/tangent_axes.h"
 
 namespace cairn {
 namespace {
@@ -114,7 +115,7 @@ void Build(SlamGraph& g, const TwoSubmaps& w, const Pose3& switch_measured, bool
       Eigen::Vector4d z = PlaneIn(poses[k], w.planes[i].first, w.planes[i].second);
       if (rng != nullptr) {
         Eigen::Vector3d u, v;
-        PlaneTangentAxes(z.head<3>(), &u, &v);
+        TangentAxes(Eigen::Vector3d(z.head<3>()), &u, &v);
         const Eigen::Vector3d e = w.plane_sigma * DrawVector3(n, *rng);
         z.head<3>() = (z.head<3>() + e.x() * u + e.y() * v).normalized();
         z.w() += e.z();

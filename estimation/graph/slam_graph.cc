@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 
 #include "estimation/graph/graph_batch_job.h"
+#include "estimation/graph/line_factors.h"
 #include "estimation/graph/marginal_covariance.h"
 #include "estimation/graph/plane_factors.h"
 #include "estimation/graph/pose_factors.h"
@@ -21,7 +22,8 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
   const K ka = KindOfKey(f.a), kb = KindOfKey(f.b);
   const bool same_robot = RobotOfVariable(f.a) == RobotOfVariable(f.b);
   auto is = [](K k) {
-    return k == K::kRobotPose || k == K::kSubmap || k == K::kLandmark || k == K::kDatum || k == K::kPlane;
+    return k == K::kRobotPose || k == K::kSubmap || k == K::kLandmark || k == K::kDatum || k == K::kPlane ||
+           k == K::kLine;
   };
   if (!is(ka) || (!IsUnary(f.kind) && !is(kb))) return InvalidArgumentError("factor on a malformed variable key");
   if (!IsUnary(f.kind) && f.a == f.b) return InvalidArgumentError("binary factor on one variable");
@@ -44,6 +46,9 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
     case FactorKind::kPlaneObservation:
       ok = ka == K::kSubmap && kb == K::kPlane;
       break;
+    case FactorKind::kLineObservation:
+      ok = ka == K::kSubmap && kb == K::kLine;
+      break;
   }
   if (!ok) return InvalidArgumentError("factor kind does not fit its variables");
   if (f.kind == FactorKind::kPlaneObservation) {
@@ -51,8 +56,17 @@ Status CheckKinds(const SlamFactor& f, char own_robot) {
         !f.z.q.coeffs().allFinite()) {
       return InvalidArgumentError("plane observation with a non-finite plane or a normal not of unit length");
     }
-    if (f.plane_information.llt().info() != Eigen::Success) {
+    if (!f.plane_information.allFinite() || f.plane_information.llt().info() != Eigen::Success) {
       return InvalidArgumentError("plane information is not positive definite");
+    }
+  } else if (f.kind == FactorKind::kLineObservation) {
+    if (!f.line_point.allFinite() || !f.line_direction.allFinite() ||
+        std::abs(f.line_direction.norm() - 1.0) > 1e-6 || !f.z.t.allFinite() || !f.z.q.coeffs().allFinite()) {
+      return InvalidArgumentError(
+          "line observation with a non-finite line or a direction not of unit length");
+    }
+    if (!f.line_information.allFinite() || f.line_information.llt().info() != Eigen::Success) {
+      return InvalidArgumentError("line information is not positive definite");
     }
   } else if (IsPositionFactor(f.kind)) {
     if (!f.position.allFinite() || !f.antenna.allFinite()) return InvalidArgumentError("non-finite position");
@@ -78,7 +92,10 @@ SlamUpdateStats StatsOf(const GraphSolveResult& r, size_t variables, std::chrono
 }  // namespace
 
 SlamGraph::SlamGraph(const SlamGraphOptions& options)
-    : options_(options), manifold_(MakePoseManifold()), plane_manifold_(MakePlaneLandmarkManifold()) {
+    : options_(options),
+      manifold_(MakePoseManifold()),
+      plane_manifold_(MakePlaneLandmarkManifold()),
+      line_manifold_(MakeLineLandmarkManifold()) {
   ceres::Problem::Options po;
   po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -100,12 +117,14 @@ Status SlamGraph::AddFactor(const SlamFactor& f) {
       return InvalidArgumentError("GNSS fix on a pose not tied to the datum");
     }
   }
-  if (f.kind == FactorKind::kPlaneObservation) {
-    // A plane fixes 3 of a pose's 6 degrees of freedom: it can neither place a submap nor join
-    // components rigidly.
-    if (!HasVariable(f.a)) return InvalidArgumentError("plane observation by an unknown submap");
+  if (IsStructureObservation(f.kind)) {
+    // A plane fixes 3 of a pose's 6 degrees of freedom, a line 4: neither can place a submap nor
+    // join components rigidly.
+    const char* what = f.kind == FactorKind::kPlaneObservation ? "plane" : "line";
+    if (!HasVariable(f.a))
+      return InvalidArgumentError(std::string(what) + " observation by an unknown submap");
     if (HasVariable(f.b) && variables_.at(f.a).component != variables_.at(f.b).component) {
-      return InvalidArgumentError("plane observation across unconnected components");
+      return InvalidArgumentError(std::string(what) + " observation across unconnected components");
     }
   }
   ++num_added_factors_;
@@ -479,7 +498,14 @@ SlamUpdateStats SlamGraph::SolveFinal() {
 }
 
 ceres::Manifold* SlamGraph::ManifoldOf(uint64_t key) const {
-  return IsPlaneVariable(key) ? plane_manifold_.get() : manifold_.get();
+  switch (TangentSizeOf(key)) {
+    case 3:
+      return plane_manifold_.get();
+    case 4:
+      return line_manifold_.get();
+    default:
+      return manifold_.get();
+  }
 }
 
 Expected<Pose3> SlamGraph::Pose(uint64_t key) const {
@@ -492,6 +518,11 @@ Expected<Pose3> SlamGraph::GlobalPose(char robot, const Pose3& T_s_x) const {
   auto it = latest_submap_.find(robot);
   if (it == latest_submap_.end()) return NotFoundError(std::string("no submap of robot ") + robot);
   return *Pose(it->second) * T_s_x;
+}
+
+bool SlamGraph::Tied(uint64_t key) const {
+  const auto it = variables_.find(key);
+  return it != variables_.end() && it->second.component == own_component_;
 }
 
 std::vector<uint64_t> SlamGraph::Unconnected() const {
@@ -521,28 +552,32 @@ std::vector<uint64_t> SlamGraph::VariableKeys() const {
 
 double SlamGraph::Chi2() const {
   double chi2 = 0.0;
-  for (const auto& f : factors_) {
-    const Pose3 a = *Pose(f.a);
-    if (f.kind == FactorKind::kAbsolutePosition) {
-      const Eigen::Vector3d e = a.t - f.position;
-      chi2 += e.dot(f.position_information * e);
-      continue;
-    }
-    if (f.kind == FactorKind::kPlaneObservation) {
-      const Eigen::Vector3d e = PlaneObservationResidual(f.plane, f.plane_information).Error(a, *Pose(f.b));
-      chi2 += e.dot(f.plane_information * e);
-      continue;
-    }
-    if (f.kind == FactorKind::kGnssPosition) {
-      const Pose3 x = *Pose(f.b);
-      const Eigen::Vector3d e = a.R().transpose() * (x.t + x.R() * f.antenna - a.t) - f.position;
-      chi2 += e.dot(f.position_information * e);
-      continue;
-    }
-    const Vector6d e = IsUnary(f.kind) ? GeodesicError(Pose3(), a, f.z) : GeodesicError(a, *Pose(f.b), f.z);
-    chi2 += e.dot(f.information * e);
-  }
+  for (const auto& f : factors_) chi2 += FactorChi2(f);
   return chi2;
+}
+
+double SlamGraph::FactorChi2(const SlamFactor& f) const {
+  const Pose3 a = *Pose(f.a);
+  if (f.kind == FactorKind::kAbsolutePosition) {
+    const Eigen::Vector3d e = a.t - f.position;
+    return e.dot(f.position_information * e);
+  }
+  if (f.kind == FactorKind::kPlaneObservation) {
+    const Eigen::Vector3d e = PlaneObservationResidual(f.plane, f.plane_information).Error(a, *Pose(f.b));
+    return e.dot(f.plane_information * e);
+  }
+  if (f.kind == FactorKind::kLineObservation) {
+    const Eigen::Vector4d e =
+        LineObservationResidual(f.line_point, f.line_direction, f.line_information).Error(a, *Pose(f.b));
+    return e.dot(f.line_information * e);
+  }
+  if (f.kind == FactorKind::kGnssPosition) {
+    const Pose3 x = *Pose(f.b);
+    const Eigen::Vector3d e = a.R().transpose() * (x.t + x.R() * f.antenna - a.t) - f.position;
+    return e.dot(f.position_information * e);
+  }
+  const Vector6d e = IsUnary(f.kind) ? GeodesicError(Pose3(), a, f.z) : GeodesicError(a, *Pose(f.b), f.z);
+  return e.dot(f.information * e);
 }
 
 Expected<std::vector<Matrix6d>> SlamGraph::Covariances(const std::vector<uint64_t>& keys) {
@@ -568,8 +603,10 @@ Expected<std::vector<Matrix6d>> SlamGraph::Covariances(const std::vector<uint64_
     for (uint64_t key : stale) {
       const int i = covariance->IndexOf(variables_.at(key).block.get());
       Matrix6d c = i < 0 ? Matrix6d::Zero() : covariance->Marginal(i);  // gauge: 0
-      if (IsPlaneVariable(key)) {
-        c.bottomRightCorner<3, 3>().setZero();  // (rx, ry, tz) and three unused dimensions
+      if (const int n = TangentSizeOf(key); n < 6) {
+        // A landmark's own tangent (plane: rx, ry, tz; line: rx, ry, tx, ty), the rest unused.
+        c.bottomRows(6 - n).setZero();
+        c.rightCols(6 - n).setZero();
       } else {
         // Ceres' quaternion tangent is half the rotation vector: scale the rotation rows and
         // columns by 2 so callers get radians.

@@ -144,6 +144,8 @@ class SlamGraph {
   Expected<Pose3> GlobalPose(char robot, const Pose3& T_s_x) const;
   // Variables not connected to the own robot's prior.
   std::vector<uint64_t> Unconnected() const;
+  // Whether `key` is a variable connected to the own robot's prior.
+  bool Tied(uint64_t key) const;
   // Moves the floating component holding `key` rigidly by `correction` (left-multiplied) and makes
   // it part of the own robot's, for a placement found outside the graph (GNSS fixes of a robot
   // never matched or seen); factors added next must tie it. Error when `key` is unknown or tied.
@@ -158,6 +160,8 @@ class SlamGraph {
   int covariance_computations() const { return covariance_computations_; }
   // Sum over factors of the squared whitened residual (no loss, no 1/2).
   double Chi2() const;
+  // One factor's share of Chi2(); its variables must be in the graph.
+  double FactorChi2(const SlamFactor& f) const;
   // The factors in the graph (not the pending ones), in insertion order, and the variables' keys.
   const std::vector<SlamFactor>& factors() const { return factors_; }
   std::vector<uint64_t> VariableKeys() const;
@@ -194,6 +198,7 @@ class SlamGraph {
   std::unique_ptr<ceres::Problem> problem_;
   std::unique_ptr<ceres::Manifold> manifold_;
   std::unique_ptr<ceres::Manifold> plane_manifold_;
+  std::unique_ptr<ceres::Manifold> line_manifold_;
   std::unique_ptr<ceres::LossFunction> cauchy_;
   std::map<uint64_t, Variable> variables_;
   std::vector<uint64_t> creation_order_;

@@ -1,5 +1,6 @@
 #include "estimation/graph/slam_graph_types.h"
 
+#include "estimation/graph/line_factors.h"
 #include "estimation/graph/plane_factors.h"
 #include "estimation/graph/pose_factors.h"
 
@@ -11,10 +12,27 @@ bool IsUnary(FactorKind kind) {
 }
 
 bool IsPoseEdge(FactorKind kind) {
-  return !IsUnary(kind) && kind != FactorKind::kGnssPosition && kind != FactorKind::kPlaneObservation;
+  return !IsUnary(kind) && kind != FactorKind::kGnssPosition && !IsStructureObservation(kind);
 }
 
-bool IsPlaneVariable(uint64_t key) { return KindOfKey(key) == VariableKind::kPlane; }
+int TangentSizeOf(uint64_t key) {
+  switch (KindOfKey(key)) {
+    case VariableKind::kPlane:
+      return 3;
+    case VariableKind::kLine:
+      return 4;
+    default:
+      return 6;
+  }
+}
+
+bool IsStructureVariable(uint64_t key) {
+  return KindOfKey(key) == VariableKind::kPlane || KindOfKey(key) == VariableKind::kLine;
+}
+
+bool IsStructureObservation(FactorKind kind) {
+  return kind == FactorKind::kPlaneObservation || kind == FactorKind::kLineObservation;
+}
 
 bool IsPositionFactor(FactorKind kind) {
   return kind == FactorKind::kAbsolutePosition || kind == FactorKind::kGnssPosition;
@@ -23,7 +41,7 @@ bool IsPositionFactor(FactorKind kind) {
 bool IsRobustFactor(FactorKind kind) {
   return kind == FactorKind::kDetection || kind == FactorKind::kLandmark || kind == FactorKind::kMatch ||
          kind == FactorKind::kAbsolutePose || kind == FactorKind::kAbsolutePosition ||
-         kind == FactorKind::kGnssPosition || kind == FactorKind::kPlaneObservation;
+         kind == FactorKind::kGnssPosition || IsStructureObservation(kind);
 }
 
 PoseGraphEdge EdgeOfFactor(const SlamFactor& f) {
@@ -45,6 +63,8 @@ ceres::CostFunction* MakeFactorCostFunction(const SlamFactor& f) {
       return GnssPositionResidual::Create(f.position, f.position_information, f.antenna);
     case FactorKind::kPlaneObservation:
       return PlaneObservationResidual::Create(f.plane, f.plane_information);
+    case FactorKind::kLineObservation:
+      return LineObservationResidual::Create(f.line_point, f.line_direction, f.line_information);
     default: return RelativePoseResidual::Create(f.z, f.information);
   }
 }

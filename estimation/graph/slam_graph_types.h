@@ -14,12 +14,14 @@ namespace cairn {
 
 // kDatum: T_world_enu, the local east-north-up frame of the team's GNSS datum in the graph's world.
 // kPlane: a plane landmark, its frame's x-y plane (plane_factors.h), on a 3-D tangent space.
+// kLine: a line landmark, its frame's z axis (line_factors.h), on a 4-D tangent space.
 enum class VariableKind : uint8_t {
   kRobotPose = 'x',
   kSubmap = 's',
   kLandmark = 'l',
   kDatum = 'e',
-  kPlane = 'p'
+  kPlane = 'p',
+  kLine = 'n'
 };
 
 // Variable key: robot letter in the top byte (as the g2o multi-robot keys), kind in the next.
@@ -43,6 +45,7 @@ enum class FactorKind {
   kAbsolutePosition,  // unary position fix in the world frame (total station)
   kGnssPosition,      // e -> x: the antenna's position in the datum's east-north-up frame
   kPlaneObservation,  // o: s -> p, a submap's planar face
+  kLineObservation,   // o: s -> n, a submap's straight edge
 };
 
 struct SlamFactor {
@@ -58,6 +61,11 @@ struct SlamFactor {
   // tangent axes; z is the plane's frame in a (where the landmark is placed when it creates it).
   Eigen::Vector4d plane = Eigen::Vector4d(0.0, 0.0, 1.0, 0.0);
   Eigen::Matrix3d plane_information = Eigen::Matrix3d::Identity();
+  // kLineObservation: a point (the edge's middle) and the unit direction of the line in a's frame,
+  // the information of line_factors.h's error e; z is the line's frame in a.
+  Eigen::Vector3d line_point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d line_direction = Eigen::Vector3d::UnitZ();
+  Eigen::Matrix4d line_information = Eigen::Matrix4d::Identity();
 };
 
 bool IsUnary(FactorKind kind);
@@ -66,8 +74,11 @@ bool IsUnary(FactorKind kind);
 bool IsPoseEdge(FactorKind kind);
 // Factors whose measurement is a position (3 residuals) rather than a pose.
 bool IsPositionFactor(FactorKind kind);
-// Whether `key` is a variable of 3 degrees of freedom (a plane landmark) rather than a pose.
-bool IsPlaneVariable(uint64_t key);
+// Degrees of freedom of variable `key`: 3 for a plane landmark, 4 for a line, 6 for a pose.
+int TangentSizeOf(uint64_t key);
+// Structure landmarks (planes, lines): no poses, no vertices of the pose graph.
+bool IsStructureVariable(uint64_t key);
+bool IsStructureObservation(FactorKind kind);
 // Factors that get the Cauchy loss (thesis 4.2.3: detections, landmarks, matches; also fixes).
 bool IsRobustFactor(FactorKind kind);
 

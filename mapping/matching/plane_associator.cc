@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "estimation/math/so3.h"
+#include "mapping/matching/unambiguous_pairs.h"
 
 namespace cairn {
 namespace {
@@ -19,14 +20,6 @@ WorldPlane ToWorld(const Eigen::Vector3d& n, double d, const Eigen::Isometry3d& 
   w.n = T.linear() * n;
   w.d = d - w.n.dot(T.translation());
   return w;
-}
-
-// The left perturbation of the graph's tangent: t + dt, Exp(dr) R.
-Eigen::Isometry3d Perturbed(const Eigen::Isometry3d& T, const Eigen::Matrix<double, 6, 1>& delta) {
-  Eigen::Isometry3d out = T;
-  out.translation() += delta.head<3>();
-  out.linear() = so3::Exp(delta.tail<3>()) * T.linear();
-  return out;
 }
 
 // A plane's (a, b, d) perturbation applied: normalize(n + a u + b v), d + dd.
@@ -91,72 +84,29 @@ double PlaneAssociator::Distance(const SubmapPlane& pa, const SubmapPlacement& p
     Eigen::Vector3d nb;
     double d_b = 0.0;
     PerturbedPlane(pb, eb, &nb, &d_b);
-    const WorldPlane w = ToWorld(nb, d_b, Perturbed(placed_b.T_world_submap, db));
-    const Eigen::Isometry3d T_w_a = Perturbed(placed_a.T_world_submap, da);
+    const WorldPlane w = ToWorld(nb, d_b, PerturbedOrigin(placed_b.T_world_submap, db));
+    const Eigen::Isometry3d T_w_a = PerturbedOrigin(placed_a.T_world_submap, da);
     const Eigen::Vector3d n = T_w_a.linear().transpose() * w.n;
     const double d = w.d + w.n.dot(T_w_a.translation());
     return Eigen::Vector3d(u.dot(n), v.dot(n), d - static_cast<double>(pa.offset));
   };
-  const Eigen::Matrix<double, 6, 1> zero6 = Eigen::Matrix<double, 6, 1>::Zero();
-  const Eigen::Vector3d e0 = error(Eigen::Vector3d::Zero(), zero6, zero6);
-  // Central differences: a handful of planes per submap, so cost is no concern.
-  constexpr double h = 1e-6;
-  Eigen::Matrix3d Jb;
-  Eigen::Matrix<double, 3, 12> Jp;
-  for (int k = 0; k < 3; ++k) {
-    Eigen::Vector3d s = Eigen::Vector3d::Zero();
-    s[k] = h;
-    Jb.col(k) = (error(s, zero6, zero6) - error(-s, zero6, zero6)) / (2 * h);
-  }
-  for (int k = 0; k < 12; ++k) {
-    Eigen::Matrix<double, 6, 1> s = zero6;
-    s[k % 6] = h;
-    Jp.col(k) =
-        k < 6
-            ? (error(Eigen::Vector3d::Zero(), s, zero6) - error(Eigen::Vector3d::Zero(), -s, zero6)) / (2 * h)
-            : (error(Eigen::Vector3d::Zero(), zero6, s) - error(Eigen::Vector3d::Zero(), zero6, -s)) /
-                  (2 * h);
-  }
-  Eigen::Matrix<double, 12, 12> P = Eigen::Matrix<double, 12, 12>::Zero();
-  P.topLeftCorner<6, 6>() = placed_a.covariance;
-  P.bottomRightCorner<6, 6>() = placed_b.covariance;
-  // A's own plane error enters with the identity: e = (a, b, d) of A's plane, negated.
-  const Eigen::Matrix3d S = Covariance(pa) + Jb * Covariance(pb) * Jb.transpose() + Jp * P * Jp.transpose();
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(0.5 * (S + S.transpose()));
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return -1.0;
-  const double chi2 = e0.dot(ldlt.solve(e0));
-  return std::isfinite(chi2) ? chi2 : -1.0;
+  return PairingChi2<3>(error, Covariance(pa), Covariance(pb), placed_a, placed_b);
 }
 
 std::vector<PlaneAssociation> PlaneAssociator::Associate(const std::vector<SubmapPlane>& a,
                                                          const SubmapPlacement& placed_a,
                                                          const std::vector<SubmapPlane>& b,
                                                          const SubmapPlacement& placed_b) const {
-  std::vector<PlaneAssociation> gated;
+  std::vector<PlaneAssociation> candidates;
   for (size_t i = 0; i < a.size(); ++i) {
     if (!Eligible(a[i])) continue;
     for (size_t j = 0; j < b.size(); ++j) {
       if (!Eligible(b[j])) continue;
-      const double chi2 = Distance(a[i], placed_a, b[j], placed_b);
-      if (chi2 >= 0.0 && chi2 <= options_.gate_chi2 + options_.ambiguity_chi2) {
-        gated.push_back(PlaneAssociation{static_cast<int>(i), static_cast<int>(j), chi2});
-      }
+      candidates.push_back(PlaneAssociation{static_cast<int>(i), static_cast<int>(j),
+                                            Distance(a[i], placed_a, b[j], placed_b)});
     }
   }
-  // Rivals are counted up to the gate plus the margin, so a pairing just inside the gate is not
-  // taken while a slightly worse rival lies just outside it.
-  std::vector<PlaneAssociation> out;
-  for (const PlaneAssociation& p : gated) {
-    if (p.chi2 > options_.gate_chi2) continue;
-    const bool ambiguous = std::any_of(gated.begin(), gated.end(), [&](const PlaneAssociation& q) {
-      return (q.a == p.a) != (q.b == p.b) && q.chi2 < p.chi2 + options_.ambiguity_chi2;
-    });
-    if (!ambiguous) out.push_back(p);
-  }
-  std::sort(out.begin(), out.end(), [](const PlaneAssociation& x, const PlaneAssociation& y) {
-    return x.a != y.a ? x.a < y.a : x.b < y.b;
-  });
-  return out;
+  return UnambiguousPairs(candidates, options_.gate_chi2, options_.ambiguity_chi2);
 }
 
 }  // namespace cairn

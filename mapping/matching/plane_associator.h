@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include "common/options_visitor.h"
+#include "mapping/matching/submap_placement.h"
 #include "mapping/submap_plane.h"
 
 namespace cairn {
@@ -39,13 +40,6 @@ struct PlaneAssociationOptions {
     v.Number("min_normal_sigma", min_normal_sigma, 0.0, 1.0, "rad");
     v.Number("min_offset_sigma", min_offset_sigma, 0.0, 10.0, "m");
   }
-};
-
-// An origin's pose in the graph's world and its marginal covariance: tangent [translation;
-// rotation vector], both in the world's axes, rotation perturbation on the left (the graph's).
-struct SubmapPlacement {
-  Eigen::Isometry3d T_world_submap = Eigen::Isometry3d::Identity();
-  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
 struct PlaneAssociation {

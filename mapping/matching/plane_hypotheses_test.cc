@@ -5,18 +5,15 @@
 
 #include <gtest/gtest.h>
 
+#include "mapping/testing/submap_faces.h"
+
 namespace cairn {
 namespace {
 
 SubmapPlane Face(const Eigen::Vector3d& normal, const Eigen::Vector3d& centroid, double half_u,
                  double half_v) {
-  SubmapPlane p;
-  p.normal = normal.normalized().cast<float>();
-  p.offset = static_cast<float>(-normal.normalized().dot(centroid));
-  p.centroid = centroid.cast<float>();
-  p.min = Eigen::Vector2f(static_cast<float>(-half_u), static_cast<float>(-half_v));
-  p.max = -p.min;
-  p.area = static_cast<float>(4 * half_u * half_v);
+  SubmapPlane p = testing::FaceSeenFrom(Eigen::Isometry3d::Identity(), normal, centroid,
+                                        Eigen::Vector2d(half_u, half_v), 0.0);
   p.points = static_cast<uint32_t>(p.area * 400);
   return p;
 }

@@ -1,0 +1,37 @@
+#include "tools/submap_truth.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "tools/commands.h"
+
+namespace cairn::tools {
+
+Status ReadSubmapTruth(const std::string& dir, std::vector<SubmapTruth>* out) {
+  const std::string index = dir + "/submaps/index.csv";
+  std::ifstream in(index);
+  if (!in) return NotFoundError(index + ": cannot open (a cairnd output folder with mapping on?)");
+  std::string line;
+  std::getline(in, line);
+  int row = 1;
+  while (std::getline(in, line)) {
+    ++row;
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    std::string item;
+    while (std::getline(fields, item, ',')) f.push_back(item);
+    if (f.size() < 7 || f[3].empty()) continue;  // no truth for this origin
+    std::vector<double> v;
+    if (!ParseNumberList(f[3] + "," + f[4] + "," + f[5] + "," + f[6], &v) || v.size() != 4)
+      return InvalidArgumentError(index + ":" + std::to_string(row) + ": bad true pose");
+    SubmapTruth s;
+    s.robot = f[0];
+    s.id = std::strtoull(f[1].c_str(), nullptr, 10);
+    s.T_world_submap = FourDofTransform(v[0], v[1], v[2], v[3]);
+    out->push_back(std::move(s));
+  }
+  return Status::Ok();
+}
+
+}  // namespace cairn::tools
