@@ -302,22 +302,12 @@ void CommsStage::PublishOwn(Timestamp now, bool flush) {
         Publish(TeamItemKind::kGnssFix, TeamItemCodec::GnssFix(report_.incarnation, o.gnss));
         break;
       case Outgoing::Kind::kPlaneObservations:
-        if (o.planes.size() > TeamItemCodec::kMaxPlaneObservations) {
-          Error(std::to_string(o.planes.size()) +
-                " plane observations of one submap, more than teammates take");
-          break;
-        }
-        for (TeamPlaneObservation& p : o.planes) SplitObservationFrames(&p);
-        Publish(TeamItemKind::kPlaneObservations, TeamItemCodec::PlaneObservations(o.planes));
+        PublishObservations(TeamItemKind::kPlaneObservations, "plane", TeamItemCodec::kMaxPlaneObservations,
+                            &o.planes, &TeamItemCodec::PlaneObservations);
         break;
       case Outgoing::Kind::kLineObservations:
-        if (o.lines.size() > TeamItemCodec::kMaxLineObservations) {
-          Error(std::to_string(o.lines.size()) +
-                " line observations of one submap, more than teammates take");
-          break;
-        }
-        for (TeamLineObservation& l : o.lines) SplitObservationFrames(&l);
-        Publish(TeamItemKind::kLineObservations, TeamItemCodec::LineObservations(o.lines));
+        PublishObservations(TeamItemKind::kLineObservations, "line", TeamItemCodec::kMaxLineObservations,
+                            &o.lines, &TeamItemCodec::LineObservations);
         break;
       case Outgoing::Kind::kFinish:
         FlushPoses();

@@ -128,6 +128,20 @@ class CommsStage final : public TeamLink {
   void FlushPoses();
   void SplitFrame(const std::string& robot, uint64_t* frame, uint32_t* incarnation) const;
   void SplitFrames(TeamMatch* match) const;
+  // One submap's landmark observations as one item (`encode` the codec's), their frames as the
+  // wire names them; more than teammates take is an error instead.
+  template <class Observation>
+  void PublishObservations(TeamItemKind kind, const char* what, size_t max,
+                           std::vector<Observation>* observations,
+                           std::string (*encode)(const std::vector<Observation>&)) {
+    if (observations->size() > max) {
+      Error(std::to_string(observations->size()) + " " + what +
+            " observations of one submap, more than teammates take");
+      return;
+    }
+    for (Observation& o : *observations) SplitObservationFrames(&o);
+    Publish(kind, encode(*observations));
+  }
   // An observation's two frames (its observer's and its creator's) as the wire names them.
   template <class Observation>
   void SplitObservationFrames(Observation* o) const {

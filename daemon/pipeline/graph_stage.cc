@@ -340,28 +340,28 @@ Status GraphStage::AddStructureFactor(const SlamFactor& f, char observer, uint64
   return Status::Ok();
 }
 
-std::vector<Status> GraphStage::AddPlaneObservations(const std::vector<TeamPlaneObservation>& observations) {
+template <class Observation, class AddOne>
+std::vector<Status> GraphStage::AddObservationBatch(const std::vector<Observation>& observations,
+                                                    AddOne add_one) {
   std::vector<Status> out;
   out.reserve(observations.size());
   bool added = false;
-  for (const TeamPlaneObservation& o : observations) {
-    out.push_back(AddPlaneObservationNoUpdate(o));
+  for (const Observation& o : observations) {
+    out.push_back(add_one(o));
     added = added || out.back().ok();
   }
   if (added) Update();
   return out;
 }
 
+std::vector<Status> GraphStage::AddPlaneObservations(const std::vector<TeamPlaneObservation>& observations) {
+  return AddObservationBatch(
+      observations, [this](const TeamPlaneObservation& o) { return AddPlaneObservationNoUpdate(o); });
+}
+
 std::vector<Status> GraphStage::AddLineObservations(const std::vector<TeamLineObservation>& observations) {
-  std::vector<Status> out;
-  out.reserve(observations.size());
-  bool added = false;
-  for (const TeamLineObservation& o : observations) {
-    out.push_back(AddLineObservationNoUpdate(o));
-    added = added || out.back().ok();
-  }
-  if (added) Update();
-  return out;
+  return AddObservationBatch(observations,
+                             [this](const TeamLineObservation& o) { return AddLineObservationNoUpdate(o); });
 }
 
 // The graph checks the measurement and its covariance (the codec has checked teammates' already).

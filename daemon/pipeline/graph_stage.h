@@ -210,6 +210,9 @@ class GraphStage {
   static SlamFactor LineFactor(const TeamLineObservation& o);
   Status AddPlaneObservationNoUpdate(const TeamPlaneObservation& o);
   Status AddLineObservationNoUpdate(const TeamLineObservation& o);
+  // Adds each observation with `add_one`, then updates the graph once if any was taken.
+  template <class Observation, class AddOne>
+  std::vector<Status> AddObservationBatch(const std::vector<Observation>& observations, AddOne add_one);
   // The checks and bookkeeping both landmark kinds share; `*created` when the factor starts its
   // landmark.
   Status AddStructureFactor(const SlamFactor& f, char observer, uint64_t frame, bool* created);

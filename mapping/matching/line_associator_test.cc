@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include "estimation/math/ordered_draws.h"
-#include "estimation/math/so3.h"
 #include "estimation/math/tangent_axes.h"
 #include "mapping/matching/testing/placements.h"
 #include "mapping/testing/submap_edges.h"
@@ -199,8 +198,7 @@ TEST(LineAssociatorTest, DistanceOfTruePairsFollowsTheStatedNoise) {
     d.tail<3>() = DrawVector3(n01, rng);
     d = d.cwiseProduct(origin_sigma);
     SubmapPlacement s = testing::PlacedWithSigma(T, origin_sigma[0], origin_sigma[3]);
-    s.T_world_submap.translation() += d.head<3>();
-    s.T_world_submap.linear() = so3::Exp(d.tail<3>()) * T.linear();
+    s.T_world_submap = PerturbedOrigin(T, d);
     return s;
   };
   const int draws = 200;
