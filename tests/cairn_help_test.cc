@@ -20,7 +20,7 @@ const std::vector<std::string> kCommands = {
     "stereo-eval",  "bench stereo", "bench fpga",  "bench filter",  "bench rt",           "graph solve",
     "graph replay", "graph inject", "bench graph", "sim",           "bench sim",          "map",
     "bench map",    "match",        "bench match", "detect",        "detect build-lut",   "detect check-lut",
-    "bench detect", "eval",         "bench vo",    "bench lines"};
+    "bench detect", "eval",         "bench vo",    "bench lines",   "bench landmarks"};
 
 std::vector<std::string> Words(const std::string& command) {
   std::vector<std::string> out{Cairn()};

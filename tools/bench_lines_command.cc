@@ -33,14 +33,6 @@ double LineMs(LineClock::time_point a, LineClock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-// Nearest-rank percentile (q in [0, 1]); NaN for no values.
-double LinePercentile(std::vector<double> v, double q) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size())));
-  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
-
 struct LineTimes {
   std::vector<double> wall, cpu;
   void Add(double w, double c) {
@@ -51,7 +43,8 @@ struct LineTimes {
 
 void PrintLineTimes(const char* name, const LineTimes& t) {
   std::printf("  %-28s wall median %6.3f ms, p90 %6.3f ms; CPU median %6.3f ms, p90 %6.3f ms\n", name,
-              Median(t.wall), LinePercentile(t.wall, 0.9), Median(t.cpu), LinePercentile(t.cpu, 0.9));
+              Median(t.wall), NearestRankPercentile(t.wall, 0.9), Median(t.cpu),
+              NearestRankPercentile(t.cpu, 0.9));
 }
 
 }  // namespace
@@ -173,10 +166,10 @@ int RunBenchLines(const CommandArgs& args) {
   PrintLineTimes("detection + triangulation", total);
   PrintLineTimes("baseline: one cv::Sobel pass", sobel);
   std::printf("  ratio (detection + triangulation) / Sobel pass, CPU: median %.1f, p90 %.1f\n", Median(ratio),
-              LinePercentile(ratio, 0.9));
+              NearestRankPercentile(ratio, 0.9));
   const double median_total = Median(total.cpu);
   std::printf("  target <= 5 ms per keyframe: median CPU %.2f ms, p90 %.2f ms (%s)\n", median_total,
-              LinePercentile(total.cpu, 0.9), median_total <= 5.0 ? "met" : "NOT met");
+              NearestRankPercentile(total.cpu, 0.9), median_total <= 5.0 ? "met" : "NOT met");
   std::printf(
       "  segments per keyframe (min length %.0f px): median %.0f (min %.0f, max %.0f); triangulated median "
       "%.0f "

@@ -78,6 +78,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"bench match",
      "time submap matching on cairnd runs' submaps; recall and precision against the simulator",
      RunBenchMatch},
+    {"bench landmarks", "time pairing submaps' straight edges into line landmarks on cairnd runs' submaps",
+     RunBenchLandmarks},
     {"detect", "AprilTag 36h11 tags in a photo: corners, T_cam_tag and its covariance as JSON", RunDetect},
     {"detect build-lut", "the precomputed tag error table of one robot camera, from rendered tags",
      RunDetectBuildLut},

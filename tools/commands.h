@@ -50,6 +50,7 @@ namespace cairn::tools {
 int RunMap(const CommandArgs& args);
 int RunBenchMap(const CommandArgs& args);
 int RunBenchLines(const CommandArgs& args);
+int RunBenchLandmarks(const CommandArgs& args);
 int RunEval(const CommandArgs& args);
 int RunBenchVo(const CommandArgs& args);
 int RunMatch(const CommandArgs& args);

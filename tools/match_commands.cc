@@ -67,29 +67,17 @@ void WriteFeatures(JsonWriter& j, const char* key, const std::string& path, cons
   j.EndObject();
 }
 
-struct IndexedSubmap {
-  std::string robot;
-  uint64_t id = 0;
-  FourDofTransform T_world_submap;  // true origin
-  std::shared_ptr<const Submap> submap;
+struct IndexedSubmap : SubmapWithTruth {
   SubmapFeatures features;
 };
 
 // The rows of DIR/submaps/index.csv that have a true pose, with their submap files.
 Status ReadIndexedSubmaps(const std::string& dir, std::vector<IndexedSubmap>* out) {
-  std::vector<SubmapTruth> truth;
-  if (Status s = ReadSubmapTruth(dir, &truth); !s.ok()) return s;
-  for (const SubmapTruth& t : truth) {
+  std::vector<SubmapWithTruth> read;
+  if (Status s = ReadSubmapsWithTruth(dir, &read); !s.ok()) return s;
+  for (SubmapWithTruth& r : read) {
     IndexedSubmap s;
-    s.robot = t.robot;
-    s.id = t.id;
-    s.T_world_submap = t.T_world_submap;
-    char name[32];
-    std::snprintf(name, sizeof(name), "-%06llu.submap", static_cast<unsigned long long>(s.id));
-    auto submap = SubmapCodec::ReadFile(dir + "/submaps/" + s.robot + name);
-    if (!submap.ok() && submap.status().code() == StatusCode::kNotFound) continue;  // listed, never finished
-    if (!submap.ok()) return submap.status();
-    s.submap = *submap;
+    static_cast<SubmapWithTruth&>(s) = std::move(r);
     out->push_back(std::move(s));
   }
   return Status::Ok();

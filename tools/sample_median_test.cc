@@ -1,6 +1,7 @@
 #include "tools/sample_median.h"
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -15,4 +16,14 @@ TEST(SampleMedianTest, OddEvenAndEmptySamples) {
 }
 
 }  // namespace
+TEST(SampleMedianTest, NearestRankPercentiles) {
+  const std::vector<double> v{5.0, 1.0, 4.0, 2.0, 3.0, 10.0, 9.0, 8.0, 7.0, 6.0};
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.0), 1.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.5), 5.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.9), 9.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 0.91), 10.0);
+  EXPECT_DOUBLE_EQ(NearestRankPercentile(v, 1.0), 10.0);
+  EXPECT_TRUE(std::isnan(NearestRankPercentile({}, 0.5)));
+}
+
 }  // namespace cairn

@@ -1,9 +1,11 @@
 #include "tools/submap_truth.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include "mapping/submap_codec.h"
 #include "tools/commands.h"
 
 namespace cairn::tools {
@@ -29,6 +31,23 @@ Status ReadSubmapTruth(const std::string& dir, std::vector<SubmapTruth>* out) {
     s.robot = f[0];
     s.id = std::strtoull(f[1].c_str(), nullptr, 10);
     s.T_world_submap = FourDofTransform(v[0], v[1], v[2], v[3]);
+    out->push_back(std::move(s));
+  }
+  return Status::Ok();
+}
+
+Status ReadSubmapsWithTruth(const std::string& dir, std::vector<SubmapWithTruth>* out) {
+  std::vector<SubmapTruth> truth;
+  if (Status s = ReadSubmapTruth(dir, &truth); !s.ok()) return s;
+  for (const SubmapTruth& t : truth) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "-%06llu.submap", static_cast<unsigned long long>(t.id));
+    auto submap = SubmapCodec::ReadFile(dir + "/submaps/" + t.robot + name);
+    if (!submap.ok() && submap.status().code() == StatusCode::kNotFound) continue;
+    if (!submap.ok()) return submap.status();
+    SubmapWithTruth s;
+    static_cast<SubmapTruth&>(s) = t;
+    s.submap = *submap;
     out->push_back(std::move(s));
   }
   return Status::Ok();

@@ -60,11 +60,66 @@ Eigen::Matrix4d LineAssociator::Covariance(const SubmapLine& l) const {
   return c;
 }
 
+LineAssociator::Prepared LineAssociator::Prepare(const SubmapLine& l, int index) const {
+  return Prepared{index, Middle(l), l.direction.cast<double>(), Covariance(l)};
+}
+
 double LineAssociator::Distance(const SubmapLine& la, const SubmapPlacement& placed_a, const SubmapLine& lb,
                                 const SubmapPlacement& placed_b) const {
-  const Eigen::Isometry3d T_a_b = placed_a.T_world_submap.inverse() * placed_b.T_world_submap;
-  const Eigen::Vector3d va = la.direction.cast<double>(), ca = Middle(la);
-  const Eigen::Vector3d vb = lb.direction.cast<double>(), cb = Middle(lb);
+  return Distance(la, Prepare(la, 0), placed_a, lb, Prepare(lb, 0), placed_b,
+                  placed_a.T_world_submap.inverse() * placed_b.T_world_submap);
+}
+
+double LineAssociator::LowerBound(const SubmapLine& la, const SubmapPlacement& placed_a, const SubmapLine& lb,
+                                  const SubmapPlacement& placed_b) const {
+  return LowerBound(Prepare(la, 0), placed_a, Prepare(lb, 0), placed_b,
+                    placed_a.T_world_submap.inverse() * placed_b.T_world_submap);
+}
+
+double LineAssociator::LowerBound(const Prepared& a, const SubmapPlacement& placed_a, const Prepared& b,
+                                  const SubmapPlacement& placed_b, const Eigen::Isometry3d& T_a_b) const {
+  // The chi2 is at least that of its direction part alone, and of its offset part alone; each of
+  // those is at least |e|^2 over the trace of the part's covariance. The traces are bounded with
+  // the norms of the Jacobians, which are simple: a turn of either line or origin by dr turns the
+  // direction by at most |dr|; it moves B's point nearest A's middle by at most (lever + 2 r) |dr|,
+  // lever being the point's distance from the turning origin and r that between the two middles;
+  // a shift moves it by at most the shift. Cross-covariances enter through Cauchy-Schwarz,
+  // tr(J P J^T) <= (sqrt(tr Jt Ptt Jt^T) + sqrt(tr Jr Prr Jr^T))^2.
+  const Eigen::Vector3d p = T_a_b * b.middle, v = T_a_b.linear() * b.direction;
+  const Eigen::Vector3d& ca = a.middle;
+  const Eigen::Vector3d& va = a.direction;
+  const double cosine = va.dot(v);
+  const double direction_error2 = std::max(0.0, 1.0 - cosine * cosine);
+  const Eigen::Vector3d offset = p + (ca - p).dot(v) * v - ca;
+  const double along = va.dot(offset);
+  const double offset_error2 = std::max(0.0, offset.squaredNorm() - along * along);
+
+  auto trace2 = [](const Eigen::Matrix4d& c, int first) { return c(first, first) + c(first + 1, first + 1); };
+  const double dir_a = trace2(a.covariance, 0), off_a = trace2(a.covariance, 2);
+  const double dir_b = trace2(b.covariance, 0), off_b = trace2(b.covariance, 2);
+  const double shift_a = placed_a.covariance.topLeftCorner<3, 3>().trace();
+  const double turn_a = placed_a.covariance.bottomRightCorner<3, 3>().trace();
+  const double shift_b = placed_b.covariance.topLeftCorner<3, 3>().trace();
+  const double turn_b = placed_b.covariance.bottomRightCorner<3, 3>().trace();
+  const double r = (ca - p).norm();
+  auto both = [](double shift_sigma, double turn_sigma) {
+    return (shift_sigma + turn_sigma) * (shift_sigma + turn_sigma);
+  };
+  const double direction_variance = dir_a + dir_b + turn_a + turn_b;
+  const double offset_variance = off_a + both(std::sqrt(off_b), 2.0 * r * std::sqrt(dir_b)) +
+                                 both(std::sqrt(shift_a), (p.norm() + 2.0 * r) * std::sqrt(turn_a)) +
+                                 both(std::sqrt(shift_b), (b.middle.norm() + 2.0 * r) * std::sqrt(turn_b));
+  const double bound = std::max(direction_variance > 0.0 ? direction_error2 / direction_variance : 0.0,
+                                offset_variance > 0.0 ? offset_error2 / offset_variance : 0.0);
+  // Slack for Distance's Jacobians being central differences rather than exact.
+  return std::isfinite(bound) ? 0.999 * bound : 0.0;
+}
+
+double LineAssociator::Distance(const SubmapLine& la, const Prepared& a, const SubmapPlacement& placed_a,
+                                const SubmapLine& lb, const Prepared& b, const SubmapPlacement& placed_b,
+                                const Eigen::Isometry3d& T_a_b) const {
+  const Eigen::Vector3d &va = a.direction, &ca = a.middle;
+  const Eigen::Vector3d &vb = b.direction, &cb = b.middle;
   // Extents: B's ends projected onto A's line, against A's extent widened by the margin.
   const Eigen::Vector3d qa = LineAt(la, 0.0);
   const double s0 = va.dot(T_a_b * LineAt(lb, lb.t_min) - qa), s1 = va.dot(T_a_b * LineAt(lb, lb.t_max) - qa);
@@ -86,20 +141,31 @@ double LineAssociator::Distance(const SubmapLine& la, const SubmapPlacement& pla
         PerturbedOrigin(placed_a.T_world_submap, da).inverse() * PerturbedOrigin(placed_b.T_world_submap, db);
     return LineErrorAt(T * p, T.linear() * v, ca, ua, wa);
   };
-  return PairingChi2<4>(error, Covariance(la), Covariance(lb), placed_a, placed_b);
+  return PairingChi2<4>(error, a.covariance, b.covariance, placed_a, placed_b);
 }
 
 std::vector<LineAssociation> LineAssociator::Associate(const std::vector<SubmapLine>& a,
                                                        const SubmapPlacement& placed_a,
                                                        const std::vector<SubmapLine>& b,
                                                        const SubmapPlacement& placed_b) const {
+  auto prepare = [&](const std::vector<SubmapLine>& lines) {
+    std::vector<Prepared> out;
+    for (size_t i = 0; i < lines.size(); ++i) {
+      if (Eligible(lines[i])) out.push_back(Prepare(lines[i], static_cast<int>(i)));
+    }
+    return out;
+  };
+  const std::vector<Prepared> pa = prepare(a), pb = prepare(b);
+  const Eigen::Isometry3d T_a_b = placed_a.T_world_submap.inverse() * placed_b.T_world_submap;
+  // A pairing beyond this is neither taken nor a rival of one that is (UnambiguousPairs).
+  const double reach = options_.gate_chi2 + options_.ambiguity_chi2;
   std::vector<LineAssociation> candidates;
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (!Eligible(a[i])) continue;
-    for (size_t j = 0; j < b.size(); ++j) {
-      if (!Eligible(b[j])) continue;
-      candidates.push_back(LineAssociation{static_cast<int>(i), static_cast<int>(j),
-                                           Distance(a[i], placed_a, b[j], placed_b)});
+  for (const Prepared& x : pa) {
+    for (const Prepared& y : pb) {
+      if (LowerBound(x, placed_a, y, placed_b, T_a_b) > reach) continue;
+      candidates.push_back(LineAssociation{x.index, y.index,
+                                           Distance(a[static_cast<size_t>(x.index)], x, placed_a,
+                                                    b[static_cast<size_t>(y.index)], y, placed_b, T_a_b)});
     }
   }
   return UnambiguousPairs(candidates, options_.gate_chi2, options_.ambiguity_chi2);

@@ -9,6 +9,7 @@
 #include "estimation/math/ordered_draws.h"
 #include "estimation/math/tangent_axes.h"
 #include "mapping/matching/testing/placements.h"
+#include "mapping/matching/unambiguous_pairs.h"
 #include "mapping/testing/submap_edges.h"
 
 namespace cairn {
@@ -218,6 +219,113 @@ TEST(LineAssociatorTest, DistanceOfTruePairsFollowsTheStatedNoise) {
               mean);
   EXPECT_GT(mean, 3.3);
   EXPECT_LT(mean, 4.7);
+}
+
+// Random edges of a random world seen from two random origins, with correlated origin covariances
+// from millimetres to half a metre: both the pairings of the same edge and those of unrelated ones.
+struct LineBoundDraws {
+  std::mt19937 rng{11};
+  std::normal_distribution<double> n01{0.0, 1.0};
+  std::uniform_real_distribution<double> u01{0.0, 1.0};
+
+  double LogUniform(double lo, double hi) { return lo * std::pow(hi / lo, u01(rng)); }
+  Eigen::Isometry3d Pose() {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = so3::Exp(Eigen::Vector3d(0.05 * n01(rng), 0.05 * n01(rng), 3.0 * n01(rng)));
+    T.translation() = Eigen::Vector3d(15.0 * n01(rng), 15.0 * n01(rng), n01(rng));
+    return T;
+  }
+  SubmapPlacement Placed(const Eigen::Isometry3d& T) {
+    Eigen::Matrix<double, 6, 6> L;
+    for (int i = 0; i < 36; ++i) L(i / 6, i % 6) = n01(rng);
+    Eigen::Matrix<double, 6, 1> sigma;
+    sigma.head<3>().setConstant(LogUniform(0.001, 0.5));
+    sigma.tail<3>().setConstant(LogUniform(0.0005, 0.05));
+    SubmapPlacement s;
+    s.T_world_submap = T;
+    s.covariance = sigma.asDiagonal() * (L * L.transpose() / 6.0) * sigma.asDiagonal();
+    return s;
+  }
+  std::pair<Eigen::Vector3d, Eigen::Vector3d> Edge() {
+    const Eigen::Vector3d p(20.0 * n01(rng), 20.0 * n01(rng), 2.0 * n01(rng));
+    // Half the edges along the world's axes, as a structured world's are: many parallel ones.
+    Eigen::Vector3d d = u01(rng) < 0.5 ? Eigen::Vector3d::Unit(static_cast<int>(3.0 * u01(rng)) % 3)
+                                       : Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
+    return {p, p + (1.0 + 5.0 * u01(rng)) * d};
+  }
+  Eigen::Vector4d Error(double sigma_r, double sigma_t) {
+    return Eigen::Vector4d(sigma_r * n01(rng), sigma_r * n01(rng), sigma_t * n01(rng), sigma_t * n01(rng));
+  }
+};
+
+TEST(LineAssociatorTest, LowerBoundNeverExceedsTheDistance) {
+  const LineAssociator associator{LineAssociationOptions{}};
+  const double reach = LineAssociationOptions{}.gate_chi2 + LineAssociationOptions{}.ambiguity_chi2;
+  LineBoundDraws d;
+  int compared = 0, beyond = 0, near = 0;
+  for (int k = 0; k < 4000; ++k) {
+    const Eigen::Isometry3d a = d.Pose(), b = d.Pose();
+    const auto ea = d.Edge();
+    // Every other draw pairs an edge with itself, seen with errors and a stretch of its own.
+    const bool same = k % 2 == 0;
+    const auto eb = same ? std::make_pair(ea.first + 0.3 * (ea.second - ea.first), ea.second) : d.Edge();
+    const double ra = d.LogUniform(0.001, 0.05), ta = d.LogUniform(0.005, 0.2);
+    const double rb = d.LogUniform(0.001, 0.05), tb = d.LogUniform(0.005, 0.2);
+    const SubmapLine la = testing::EdgeSeenFrom(a, ea.first, ea.second, ra, ta, d.Error(ra, ta));
+    const SubmapLine lb = testing::EdgeSeenFrom(b, eb.second, eb.first, rb, tb, d.Error(rb, tb));
+    // Every third draw the graph places B far from where it is.
+    const SubmapPlacement pa = d.Placed(a), pb = d.Placed(k % 3 == 0 ? d.Pose() : b);
+    const double chi2 = associator.Distance(la, pa, lb, pb);
+    if (chi2 < 0.0) continue;
+    ++compared;
+    const double bound = associator.LowerBound(la, pa, lb, pb);
+    ASSERT_LE(bound, chi2) << "draw " << k;
+    beyond += bound > reach;
+    near += chi2 <= reach;
+  }
+  std::printf("[ lines] %d pairings compared: %d within reach, %d put beyond it by the bound alone\n",
+              compared, near, beyond);
+  // The bound must also be of use: most of the pairings out of reach are found by it.
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(beyond, (compared - near) / 2);
+}
+
+TEST(LineAssociatorTest, DecidesAsTheSearchOfEveryPairing) {
+  const LineAssociationOptions options;
+  const LineAssociator associator(options);
+  LineBoundDraws d;
+  int paired = 0;
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::Isometry3d a = d.Pose();
+    const Eigen::Isometry3d b = a * testing::YawedPose(3.0 * d.n01(d.rng), 3.0 * d.n01(d.rng), d.n01(d.rng));
+    std::vector<SubmapLine> la, lb;
+    for (int e = 0; e < 40; ++e) {
+      const auto edge = d.Edge();
+      const double r = d.LogUniform(0.001, 0.02), t = d.LogUniform(0.005, 0.05);
+      la.push_back(testing::EdgeSeenFrom(a, edge.first, edge.second, r, t, d.Error(r, t)));
+      if (e % 2 == 0) lb.push_back(testing::EdgeSeenFrom(b, edge.second, edge.first, r, t, d.Error(r, t)));
+    }
+    const SubmapPlacement pa = testing::PlacedWithSigma(a, 0.05, 0.005);
+    const SubmapPlacement pb =
+        testing::PlacedWithSigma(b, d.LogUniform(0.01, 0.5), d.LogUniform(0.001, 0.05));
+    std::vector<LineAssociation> every;
+    for (size_t i = 0; i < la.size(); ++i) {
+      for (size_t j = 0; j < lb.size(); ++j) {
+        every.push_back(LineAssociation{static_cast<int>(i), static_cast<int>(j),
+                                        associator.Distance(la[i], pa, lb[j], pb)});
+      }
+    }
+    const auto expected = UnambiguousPairs(every, options.gate_chi2, options.ambiguity_chi2);
+    const auto pairs = associator.Associate(la, pa, lb, pb);
+    ASSERT_EQ(pairs.size(), expected.size()) << "world " << k;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      EXPECT_EQ(pairs[i].a, expected[i].a);
+      EXPECT_EQ(pairs[i].b, expected[i].b);
+      EXPECT_DOUBLE_EQ(pairs[i].chi2, expected[i].chi2);
+    }
+    paired += static_cast<int>(pairs.size());
+  }
+  EXPECT_GT(paired, 100);
 }
 
 }  // namespace
