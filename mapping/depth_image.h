@@ -33,6 +33,10 @@ struct DepthImage {
   static Expected<DepthImage> FromDisparity(std::span<const int16_t> disparity, int width, int height,
                                             double focal_px, double baseline,
                                             double disparity_offset_px = 0.0);
+  // The same into this image, whose buffers keep their capacity: no allocation once an image of
+  // the size has been held. The time, intensity and lines are left as they were.
+  Status AssignDisparity(std::span<const int16_t> disparity, int width, int height, double focal_px,
+                         double baseline, double disparity_offset_px = 0.0);
 };
 
 // The rectified left camera of a stereo pair and where it sits on the body.

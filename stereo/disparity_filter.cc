@@ -193,7 +193,8 @@ void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, 
   pool->ForEach(bands, fill);
   // Join the open regions across the band borders (union-find over their ids), then clear the
   // joined regions that stay small.
-  std::vector<Open*> open;  // by index
+  std::vector<Open*>& open = open_;  // by index
+  open.clear();
   for (Band& band : bands_) {
     for (Open& o : band.open) open.push_back(&o);
   }
@@ -212,7 +213,8 @@ void DisparityFilter::RemoveSpeckles(int16_t* disparity, int width, int height, 
     }
     return i;
   };
-  std::vector<int64_t> size(open.size());
+  std::vector<int64_t>& size = open_size_;
+  size.resize(open.size());
   for (size_t i = 0; i < open.size(); ++i) size[i] = open[i]->size;
   for (int b = 1; b < bands; ++b) {
     int y0, y1;

@@ -47,6 +47,10 @@ class DisparityFilter {
 
   std::vector<Band> bands_;
   std::vector<int32_t> parent_;
+  // The open regions of all bands by id, and their joined sizes: members so that their
+  // capacity stays from one image to the next.
+  std::vector<Open*> open_;
+  std::vector<int64_t> open_size_;
 };
 
 }  // namespace cairn

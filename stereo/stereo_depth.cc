@@ -63,7 +63,11 @@ void ComputeStereoDepth(const StereoMatcherInput& input, double pixel_error_px,
     for (size_t i = begin; i < end; ++i) at(disparity[i], &out->depth[i], &out->depth_sigma[i]);
     return;
   }
-  std::vector<float> table(2 * static_cast<size_t>(hi - lo + 1));
+  // Per thread (the matchers call this from their workers, a band each), at its largest from the
+  // start: the matching path allocates nothing after each worker's first image.
+  thread_local std::vector<float> table;
+  table.reserve(2 * static_cast<size_t>(kMaxTable));
+  table.resize(2 * static_cast<size_t>(hi - lo + 1));
   for (int d = lo; d <= hi; ++d) {
     at(static_cast<int16_t>(d), &table[2 * static_cast<size_t>(d - lo)],
        &table[2 * static_cast<size_t>(d - lo) + 1]);

@@ -109,23 +109,25 @@ void MappingStage::OnPair(const RectifiedPair& pair) {
   }
   match_time_.Record(clock.Now() - start);
   ++report_.pairs;
-  auto depth = DepthImage::FromDisparity(disparity_.disparity, disparity_.width, disparity_.height, in.focal_px,
-                                         in.baseline_m);
-  if (!depth.ok()) {
+  DepthImage& depth = waiting_.Next();
+  if (Status s = depth.AssignDisparity(disparity_.disparity, disparity_.width, disparity_.height, in.focal_px,
+                                       in.baseline_m);
+      !s.ok()) {
     ++report_.match_failures;
-    Error(depth.status().ToString());
+    Error(s.ToString());
     return;
   }
-  depth->time = pair.time;
-  depth->intensity.resize(static_cast<size_t>(in.width) * static_cast<size_t>(in.height));
+  depth.time = pair.time;
+  depth.intensity.resize(static_cast<size_t>(in.width) * static_cast<size_t>(in.height));
   for (int y = 0; y < in.height; ++y) {
-    std::copy_n(pair.left.row(y), in.width, depth->intensity.data() + static_cast<size_t>(y) * in.width);
+    std::copy_n(pair.left.row(y), in.width, depth.intensity.data() + static_cast<size_t>(y) * in.width);
   }
+  depth.lines.clear();
   // The edges now, while this pair's disparity is at hand; they wait for the pose with the image.
   if (lines_ != nullptr) {
     const Timestamp line_start = clock.Now();
     KeyframeLineExtractor::Stats stats;
-    if (lines_->Extract(in.left, in.width, in.height, in.stride, disparity_, &depth->lines, &stats)) {
+    if (lines_->Extract(in.left, in.width, in.height, in.stride, disparity_, &depth.lines, &stats)) {
       line_time_.Record(clock.Now() - line_start);
       report_.line_segments += static_cast<uint64_t>(stats.detected);
       report_.line_sightings += static_cast<uint64_t>(stats.triangulated);
@@ -133,18 +135,18 @@ void MappingStage::OnPair(const RectifiedPair& pair) {
       Error("lines at " + std::to_string(pair.time.seconds()) + " s: the disparity does not fit the image");
     }
   }
+  waiting_.Push();
   // A pose comes within a few frames; images that wait longer than a second's worth of frames are
   // the oldest and the least useful.
-  if (waiting_.size() >= 16) {
-    waiting_.pop_front();
+  if (waiting_.size() > kWaitingImages) {
+    waiting_.Pop();
     ++report_.images_dropped;
   }
-  waiting_.push_back(std::move(*depth));
 }
 
 void MappingStage::ProcessReady(bool final) {
   while (!waiting_.empty()) {
-    const DepthImage& image = waiting_.front();
+    const DepthImage& image = waiting_.Front();
     while (!estimates_.empty() && estimates_.front().time < image.time) estimates_.pop_front();
     if (estimates_.empty() && !final) return;  // its estimate is still to come
     if (!estimates_.empty() && estimates_.front().time == image.time && estimates_.front().valid) {
@@ -152,7 +154,7 @@ void MappingStage::ProcessReady(bool final) {
     } else {
       ++report_.images_without_pose;
     }
-    waiting_.pop_front();
+    waiting_.Pop();
   }
 }
 

@@ -18,6 +18,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/reuse_ring.h"
 #include "daemon/pipeline/dense_stereo_options.h"
 #include "daemon/pipeline/estimation_stage.h"
 #include "daemon/pipeline/latency_histogram.h"
@@ -137,7 +138,11 @@ class MappingStage {
   uint64_t frame_id_ = 0;  // the mapper's current local frame
   // T_first_frame of every local frame seen (the chain of switches; the graph refines it later).
   std::map<uint64_t, Eigen::Isometry3d> T_first_frame_;
-  std::deque<DepthImage> waiting_;
+  // Images waiting for their pose: a second's worth of frames at most (older ones are the least
+  // useful), in slots whose buffers are reused, so a pair costs no allocation of its size. One
+  // slot more, to convert a pair into before the oldest image is given up for it.
+  static constexpr size_t kWaitingImages = 16;
+  ReuseRing<DepthImage, kWaitingImages + 1> waiting_;
   std::deque<FrameEstimate> estimates_;
   std::deque<FrameSwitchEvent> switches_;
   LatencyHistogram match_time_, map_time_, line_time_;
