@@ -9,9 +9,8 @@
 #include "common/bounded_errors.h"
 #include "common/heap_bytes.h"
 #include "common/monotonic_clock.h"
+#include "daemon/pipeline/structure_observation_factors.h"
 #include "detection/gravity_agreement.h"
-#include "estimation/graph/line_factors.h"
-#include "estimation/graph/plane_factors.h"
 
 namespace cairn {
 namespace {
@@ -50,6 +49,7 @@ GraphStage::GraphStage(const GraphStageOptions& options, bool deterministic)
       }()),
       graph_(options_.optimizer),
       robot_(options_.optimizer.own_robot),
+      trajectories_(robot_),
       gnss_(options_.gnss) {}
 
 uint64_t GraphStage::OriginKey(uint64_t frame_id) const {
@@ -118,11 +118,11 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
     ++report_.unplaced;
     return;
   }
-  estimates_.push_back(Placed{e.time, e.frame_id, e.T_frame_body});
+  trajectories_.AddOwnEstimate(PlacedEstimate{e.time, e.frame_id, e.T_frame_body});
   if (!pending_detections_.empty()) RetryPendingDetections();
   if (!pending_fixes_.empty()) RetryPendingFixes();
-  if ((estimates_.size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
-  pose_covariances_[RunKey{robot_, kCurrentRun}].push_back(PoseCovariance{e.time, e.frame_id, e.pose_covariance});
+  if ((trajectories_.Own().size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
+  trajectories_.AddPoseCovariance(robot_, kCurrentRun, e.time, e.frame_id, e.pose_covariance);
   SlamFactor v;
   v.kind = FactorKind::kFilterEstimate;
   v.a = OriginKey(e.frame_id);
@@ -230,7 +230,9 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
       break;
     }
     case TeamInput::Kind::kPoses: {
-      for (const TeamPose& p : in.poses) team_estimates_[RunKey{r, RunOfIndex(p.frame)}].push_back(Placed{p.time, p.frame, p.T_frame_body});
+      for (const TeamPose& p : in.poses)
+        trajectories_.AddTeamEstimate(r, RunOfIndex(p.frame),
+                                      PlacedEstimate{p.time, p.frame, p.T_frame_body});
       for (const TeamGraphPose& g : in.graph_poses) {
         SlamFactor v;
         v.kind = FactorKind::kFilterEstimate;
@@ -239,7 +241,7 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
         v.z = ToPose3(g.pose.T_frame_body);
         v.information = Floored(g.covariance).inverse();
         if (Add(v)) ++report_.team_factors;
-        pose_covariances_[RunKey{r, RunOfIndex(g.pose.frame)}].push_back(PoseCovariance{g.pose.time, g.pose.frame, g.covariance});
+        trajectories_.AddPoseCovariance(r, RunOfIndex(g.pose.frame), g.pose.time, g.pose.frame, g.covariance);
       }
       if (!pending_detections_.empty()) RetryPendingDetections();
       break;
@@ -279,46 +281,6 @@ void GraphStage::OnTeamInput(const TeamInput& in) {
   // New estimates of a teammate, or a tie to its subgraph, may place its waiting fixes.
   if (!pending_fixes_.empty() && in.kind != TeamInput::Kind::kGnssFix) RetryPendingFixes();
   Update();
-}
-
-uint64_t PlaneLandmarkKey(char letter, uint64_t frame, uint32_t plane) {
-  // The run in the top bits as in frame indices; the frame and the plane (< 256) below them.
-  const uint64_t local = ((LocalIndex(frame) << 8) | (plane & 0xffu)) & ((uint64_t{1} << kRunShift) - 1);
-  return VariableKey(VariableKind::kPlane, letter,
-                     (static_cast<uint64_t>(RunOfIndex(frame)) << kRunShift) | local);
-}
-
-uint64_t LineLandmarkKey(char letter, uint64_t frame, uint32_t line) {
-  const uint64_t local = ((LocalIndex(frame) << 10) | (line & 0x3ffu)) & ((uint64_t{1} << kRunShift) - 1);
-  return VariableKey(VariableKind::kLine, letter,
-                     (static_cast<uint64_t>(RunOfIndex(frame)) << kRunShift) | local);
-}
-
-SlamFactor GraphStage::PlaneFactor(const TeamPlaneObservation& o) {
-  SlamFactor f;
-  f.kind = FactorKind::kPlaneObservation;
-  f.a = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
-  f.b = PlaneLandmarkKey(o.creator_letter, o.creator_frame, o.plane);
-  const Eigen::Vector3d n = o.normal.normalized();
-  f.plane = Eigen::Vector4d(n.x(), n.y(), n.z(), o.offset);
-  f.plane_information = o.covariance.inverse();
-  f.plane_information = 0.5 * (f.plane_information + f.plane_information.transpose());
-  // Where a new landmark starts: the face's centroid, moved onto the plane.
-  f.z = PlaneLandmarkFrame(n, o.centroid - (n.dot(o.centroid) + o.offset) * n);
-  return f;
-}
-
-SlamFactor GraphStage::LineFactor(const TeamLineObservation& o) {
-  SlamFactor f;
-  f.kind = FactorKind::kLineObservation;
-  f.a = VariableKey(VariableKind::kSubmap, o.observer_letter, o.frame);
-  f.b = LineLandmarkKey(o.creator_letter, o.creator_frame, o.line);
-  f.line_point = o.point;
-  f.line_direction = o.direction.normalized();
-  f.line_information = o.covariance.inverse();
-  f.line_information = 0.5 * (f.line_information + f.line_information.transpose());
-  f.z = LineLandmarkFrame(f.line_direction, o.point);  // where a new landmark starts
-  return f;
 }
 
 Status GraphStage::AddStructureFactor(const SlamFactor& f, char observer, uint64_t frame, bool* created) {
@@ -366,13 +328,10 @@ std::vector<Status> GraphStage::AddLineObservations(const std::vector<TeamLineOb
 
 // The graph checks the measurement and its covariance (the codec has checked teammates' already).
 Status GraphStage::AddPlaneObservationNoUpdate(const TeamPlaneObservation& o) {
-  if (o.observer_letter == 0 || o.creator_letter == 0) {
-    return InvalidArgumentError("plane observation naming a robot not in the team");
-  }
-  if (o.plane > 255 || o.observer_plane > 255)
-    return InvalidArgumentError("plane observation: plane index above 255");
+  const Expected<SlamFactor> f = PlaneObservationFactor(o);
+  if (!f.ok()) return f.status();
   bool created = false;
-  const Status s = AddStructureFactor(PlaneFactor(o), o.observer_letter, o.frame, &created);
+  const Status s = AddStructureFactor(*f, o.observer_letter, o.frame, &created);
   if (s.ok()) {
     ++report_.plane_observations;
     if (created) ++report_.plane_landmarks;
@@ -381,13 +340,10 @@ Status GraphStage::AddPlaneObservationNoUpdate(const TeamPlaneObservation& o) {
 }
 
 Status GraphStage::AddLineObservationNoUpdate(const TeamLineObservation& o) {
-  if (o.observer_letter == 0 || o.creator_letter == 0) {
-    return InvalidArgumentError("line observation naming a robot not in the team");
-  }
-  if (o.line > 1023 || o.observer_line > 1023)
-    return InvalidArgumentError("line observation: line index above 1023");
+  const Expected<SlamFactor> f = LineObservationFactor(o);
+  if (!f.ok()) return f.status();
   bool created = false;
-  const Status s = AddStructureFactor(LineFactor(o), o.observer_letter, o.frame, &created);
+  const Status s = AddStructureFactor(*f, o.observer_letter, o.frame, &created);
   if (s.ok()) {
     ++report_.line_observations;
     if (created) ++report_.line_landmarks;
@@ -395,16 +351,18 @@ Status GraphStage::AddLineObservationNoUpdate(const TeamLineObservation& o) {
   return s;
 }
 
+Expected<double> GraphStage::StructureObservationChi2(const Expected<SlamFactor>& f) const {
+  if (!f.ok()) return f.status();
+  if (structure_factors_.count({f->a, f->b}) == 0) return NotFoundError("observation not in the graph");
+  return graph_.FactorChi2(*f);
+}
+
 Expected<double> GraphStage::PlaneObservationChi2(const TeamPlaneObservation& o) const {
-  const SlamFactor f = PlaneFactor(o);
-  if (structure_factors_.count({f.a, f.b}) == 0) return NotFoundError("plane observation not in the graph");
-  return graph_.FactorChi2(f);
+  return StructureObservationChi2(PlaneObservationFactor(o));
 }
 
 Expected<double> GraphStage::LineObservationChi2(const TeamLineObservation& o) const {
-  const SlamFactor f = LineFactor(o);
-  if (structure_factors_.count({f.a, f.b}) == 0) return NotFoundError("line observation not in the graph");
-  return graph_.FactorChi2(f);
+  return StructureObservationChi2(LineObservationFactor(o));
 }
 
 bool GraphStage::PlaceOrigins(const std::vector<std::pair<char, uint64_t>>& origins,
@@ -500,110 +458,9 @@ void GraphStage::AddDetection(const TeamDetection& detection, bool usable, const
   ++report_.detections_unplaced;
 }
 
-const std::vector<GraphStage::Placed>* GraphStage::Estimates(char robot, uint32_t run) const {
-  if (robot == robot_ && run == kCurrentRun) return &estimates_;
-  const auto it = team_estimates_.find(RunKey{robot, run});
-  return it == team_estimates_.end() ? nullptr : &it->second;
-}
+std::vector<uint32_t> GraphStage::Runs(char robot) const { return trajectories_.Runs(robot); }
 
-std::vector<uint32_t> GraphStage::Runs(char robot) const {
-  std::vector<uint32_t> out;
-  for (auto it = team_estimates_.lower_bound(RunKey{robot, 0}); it != team_estimates_.end() && it->first.first == robot; ++it) {
-    if (!it->second.empty()) out.push_back(it->first.second);
-  }
-  if (robot == robot_) {
-    // Run 0 sorts first but is the newest.
-    out.erase(std::remove(out.begin(), out.end(), kCurrentRun), out.end());
-    out.push_back(kCurrentRun);
-  }
-  return out;
-}
-
-uint32_t GraphStage::LatestRun(char robot) const {
-  const std::vector<uint32_t> runs = Runs(robot);
-  return runs.empty() ? RunOfIndex(RunIndex(0, 0)) : runs.back();
-}
-
-uint32_t GraphStage::RunAt(char robot, Timestamp time) const {
-  // A restarted robot's clock may start over: of the runs begun by `time`, the one begun last.
-  const std::vector<uint32_t> runs = Runs(robot);
-  uint32_t best = runs.empty() ? LatestRun(robot) : runs.back();
-  bool found = false;
-  Timestamp best_start;
-  for (uint32_t run : runs) {
-    const std::vector<Placed>* s = Estimates(robot, run);
-    if (s == nullptr || s->empty() || s->front().time > time) continue;
-    if (!found || s->front().time >= best_start) {
-      best = run;
-      best_start = s->front().time;
-      found = true;
-    }
-  }
-  return best;
-}
-
-GraphStage::PoseLookup GraphStage::PoseAt(char robot, uint32_t run, Timestamp time, Placed* pose, Matrix6d* covariance,
-                                          std::string* why) const {
-  const std::vector<Placed>* stream = Estimates(robot, run);
-  if (stream == nullptr) return PoseLookup::kWait;
-  if (stream->empty() || stream->back().time < time) return PoseLookup::kWait;
-  const auto after = std::lower_bound(stream->begin(), stream->end(), time,
-                                      [](const Placed& p, Timestamp t) { return p.time < t; });
-  // Estimates come at the camera rate: a gap of several frames means the filter was not running.
-  const Duration max_gap = Duration::Seconds(0.5);
-  if (after->time == time) {
-    *pose = *after;
-  } else if (after == stream->begin()) {
-    *why = std::string("no estimate of ") + robot + " before that time";
-    return PoseLookup::kNever;
-  } else {
-    const Placed& before = *(after - 1);
-    if (after->time - before.time > max_gap) {
-      *why = std::string("a gap in ") + robot + "'s estimates at that time";
-      return PoseLookup::kNever;
-    }
-    if (before.frame_id != after->frame_id) {
-      // A frame switch between the two: the nearer one, if near.
-      const Placed& near = (time - before.time) < (after->time - time) ? before : *after;
-      if (std::abs((near.time - time).seconds()) > 0.05) {
-        *why = std::string("a frame switch of ") + robot + " at that time";
-        return PoseLookup::kNever;
-      }
-      *pose = near;
-    } else {
-      const double s = (time - before.time).seconds() / (after->time - before.time).seconds();
-      pose->time = time;
-      pose->frame_id = before.frame_id;
-      pose->T_frame_body = Eigen::Isometry3d::Identity();
-      pose->T_frame_body.translation() =
-          (1.0 - s) * before.T_frame_body.translation() + s * after->T_frame_body.translation();
-      pose->T_frame_body.linear() = Eigen::Quaterniond(before.T_frame_body.linear())
-                                        .slerp(s, Eigen::Quaterniond(after->T_frame_body.linear()))
-                                        .normalized()
-                                        .toRotationMatrix();
-    }
-  }
-  // The filter's covariance in its frame changes slowly: the nearest graph pose's, same frame.
-  // Which one is nearest is settled once a graph pose at or after `time` is in; choosing earlier
-  // would make the factor depend on when the poses arrived, and teammates' graphs differ.
-  const auto c = pose_covariances_.find(RunKey{robot, run});
-  if (c == pose_covariances_.end() || c->second.empty() || c->second.back().time < time) return PoseLookup::kWait;
-  const Duration window = Duration::Seconds(2.0);
-  const PoseCovariance* best = nullptr;
-  for (auto it = c->second.rbegin(); it != c->second.rend(); ++it) {
-    if (it->frame_id != pose->frame_id) continue;
-    if (best == nullptr || std::abs((it->time - time).seconds()) < std::abs((best->time - time).seconds())) best = &*it;
-    if (it->time < time - window) break;
-  }
-  if (best != nullptr && std::abs((best->time - time).seconds()) <= window.seconds()) {
-    *covariance = best->covariance;
-    return PoseLookup::kReady;
-  }
-  *why = std::string("no graph pose of ") + robot + " near that time";
-  return PoseLookup::kNever;
-}
-
-uint64_t GraphStage::DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose,
+uint64_t GraphStage::DetectionPose(char robot, uint32_t run, Timestamp time, const PlacedEstimate& pose,
                                    const Matrix6d& covariance) {
   // Indexed by run and millisecond, apart from the filter's poses: every robot names it alike.
   // 42 bits of milliseconds reach past 2100 in Unix time; runs wrap after 32.
@@ -621,9 +478,9 @@ uint64_t GraphStage::DetectionPose(char robot, uint32_t run, Timestamp time, con
   return key;
 }
 
-bool GraphStage::AgreesWithGravity(const TeamDetection& d, const Placed& observer, const Placed& observed,
-                                   Eigen::Isometry3d* T_observer_observed, std::string* chosen,
-                                   std::string* refused) {
+bool GraphStage::AgreesWithGravity(const TeamDetection& d, const PlacedEstimate& observer,
+                                   const PlacedEstimate& observed, Eigen::Isometry3d* T_observer_observed,
+                                   std::string* chosen, std::string* refused) {
   // Each robot's roll and pitch, as its filter knows them from gravity: a conservative sigma for
   // an IMU of the MTi-10 class. The gate is chi-square with 2 degrees of freedom at 99.9 %.
   constexpr double kAttitudeSigma = 1.0 * std::numbers::pi / 180;
@@ -657,20 +514,22 @@ void GraphStage::RetryPendingDetections() {
   for (size_t i = 0; i < pending_detections_.size();) {
     DetectionRecord& rec = detection_records_[pending_detections_[i]];
     const TeamDetection& d = rec.detection;
-    Placed obs, tgt;
+    PlacedEstimate obs, tgt;
     Matrix6d obs_cov, tgt_cov;
     std::string why_a, why_b;
-    const uint32_t observed_run = d.landmark ? 0 : RunAt(d.observed_letter, d.time);
-    PoseLookup a = PoseAt(d.observer_letter, d.observer_run, d.time, &obs, &obs_cov, &why_a);
-    PoseLookup b = d.landmark ? PoseLookup::kReady
-                              : PoseAt(d.observed_letter, observed_run, d.time, &tgt, &tgt_cov, &why_b);
-    if (a == PoseLookup::kNever || b == PoseLookup::kNever) {
-      rec.status = "unplaced: " + (a == PoseLookup::kNever ? why_a : why_b);
+    const uint32_t observed_run = d.landmark ? 0 : trajectories_.RunAt(d.observed_letter, d.time);
+    RobotTrajectories::Lookup a =
+        trajectories_.PoseAt(d.observer_letter, d.observer_run, d.time, &obs, &obs_cov, &why_a);
+    RobotTrajectories::Lookup b =
+        d.landmark ? RobotTrajectories::Lookup::kReady
+                   : trajectories_.PoseAt(d.observed_letter, observed_run, d.time, &tgt, &tgt_cov, &why_b);
+    if (a == RobotTrajectories::Lookup::kNever || b == RobotTrajectories::Lookup::kNever) {
+      rec.status = "unplaced: " + (a == RobotTrajectories::Lookup::kNever ? why_a : why_b);
       ++report_.detections_unplaced;
       pending_detections_.erase(pending_detections_.begin() + static_cast<long>(i));
       continue;
     }
-    if (a == PoseLookup::kWait || b == PoseLookup::kWait) {
+    if (a == RobotTrajectories::Lookup::kWait || b == RobotTrajectories::Lookup::kWait) {
       ++i;
       continue;
     }
@@ -753,16 +612,17 @@ void GraphStage::RetryPendingFixes() {
   size_t kept = 0;
   for (size_t k = 0; k < pending_fixes_.size(); ++k) {
     const TeamGnssFix& f = pending_fixes_[k];
-    Placed pose;
+    PlacedEstimate pose;
     Matrix6d covariance;
     std::string why;
-    const PoseLookup lookup = PoseAt(f.letter, f.run, f.fix.time, &pose, &covariance, &why);
+    const RobotTrajectories::Lookup lookup =
+        trajectories_.PoseAt(f.letter, f.run, f.fix.time, &pose, &covariance, &why);
     const uint64_t origin = VariableKey(VariableKind::kSubmap, f.letter, pose.frame_id);
-    if (lookup == PoseLookup::kNever) {
+    if (lookup == RobotTrajectories::Lookup::kNever) {
       ++report_.gnss_unplaced;
       continue;
     }
-    bool wait = lookup == PoseLookup::kWait || !graph_.HasVariable(origin);
+    bool wait = lookup == RobotTrajectories::Lookup::kWait || !graph_.HasVariable(origin);
     if (!wait && f.letter != robot_) {
       if (!loose_known) {
         const std::vector<uint64_t> u = graph_.Unconnected();
@@ -771,7 +631,7 @@ void GraphStage::RetryPendingFixes() {
       }
       wait = loose.count(origin) != 0;  // its fix cannot place a floating subgraph
     }
-    if (wait && lookup == PoseLookup::kReady && graph_.HasVariable(origin)) {
+    if (wait && lookup == RobotTrajectories::Lookup::kReady && graph_.HasVariable(origin)) {
       // Placeable in its floating subgraph: a candidate for placing that subgraph by its fixes.
       const uint64_t key = DetectionPose(f.letter, f.run, f.fix.time, pose, covariance);
       if (const auto T_floating_body = graph_.Pose(key); T_floating_body.ok()) {
@@ -843,7 +703,7 @@ std::vector<char> GraphStage::Robots() const {
   return out;
 }
 
-bool GraphStage::Connected(char robot) const { return Connected(robot, LatestRun(robot)); }
+bool GraphStage::Connected(char robot) const { return Connected(robot, trajectories_.LatestRun(robot)); }
 
 bool GraphStage::Connected(char robot, uint32_t run) const {
   if (robot == robot_ && run == kCurrentRun) return true;
@@ -894,9 +754,7 @@ std::vector<OriginEstimate> GraphStage::OriginEstimates(bool covariances) {
 
 GraphStageReport GraphStage::report() const {
   GraphStageReport r = report_;
-  r.history_bytes = HeapBytes(estimates_, detection_records_);
-  for (const auto& [run, v] : team_estimates_) r.history_bytes += HeapBytes(v);
-  for (const auto& [run, v] : pose_covariances_) r.history_bytes += HeapBytes(v);
+  r.history_bytes = HeapBytes(detection_records_) + trajectories_.bytes();
   return r;
 }
 
@@ -912,10 +770,10 @@ std::map<uint64_t, Eigen::Isometry3d> GraphStage::FrameOrigins(char robot) const
 }
 
 bool GraphStage::LatestGlobalPose(char robot, StampedPose* out) const {
-  const uint32_t run = LatestRun(robot);
-  const std::vector<Placed>* placed = Estimates(robot, run);
+  const uint32_t run = trajectories_.LatestRun(robot);
+  const std::vector<PlacedEstimate>* placed = trajectories_.Estimates(robot, run);
   if (placed == nullptr || placed->empty() || !Connected(robot, run)) return false;
-  const Placed& e = placed->back();
+  const PlacedEstimate& e = placed->back();
   const auto origin = graph_.Pose(VariableKey(VariableKind::kSubmap, robot, e.frame_id));
   if (!origin.ok()) return false;
   *out = StampedPose{e.time, ToIsometry(*origin) * e.T_frame_body};
@@ -934,17 +792,19 @@ bool GraphStage::LandmarkGlobalPose(size_t index, Eigen::Isometry3d* T_global_la
 
 Trajectory GraphStage::GlobalTrajectory() const { return GlobalTrajectory(robot_); }
 
-Trajectory GraphStage::GlobalTrajectory(char robot) const { return GlobalTrajectory(robot, LatestRun(robot)); }
+Trajectory GraphStage::GlobalTrajectory(char robot) const {
+  return GlobalTrajectory(robot, trajectories_.LatestRun(robot));
+}
 
 Trajectory GraphStage::GlobalTrajectory(char robot, uint32_t run) const {
   Trajectory t;
   t.frame = "global";
   if (!Connected(robot, run)) return t;
   const auto origins = FrameOrigins(robot);
-  const std::vector<Placed>* placed = Estimates(robot, run);
+  const std::vector<PlacedEstimate>* placed = trajectories_.Estimates(robot, run);
   if (placed == nullptr) return t;
   t.poses.reserve(placed->size());
-  for (const Placed& e : *placed) {
+  for (const PlacedEstimate& e : *placed) {
     const auto origin = origins.find(e.frame_id);
     if (origin == origins.end()) continue;
     t.poses.push_back(StampedPose{e.time, origin->second * e.T_frame_body});
@@ -959,7 +819,7 @@ GraphScene GraphStage::Scene(bool covariances) {
   const std::set<uint64_t> loose(unconnected.begin(), unconnected.end());
   // A robot's latest run goes by its letter, runs before a restart by their incarnation.
   const auto run_name = [this](char robot, uint32_t run) {
-    return std::string(1, robot) + (run == LatestRun(robot) ? "" : EarlierRunSuffix(run));
+    return std::string(1, robot) + (run == trajectories_.LatestRun(robot) ? "" : EarlierRunSuffix(run));
   };
   for (uint64_t key : graph_.VariableKeys()) {
     if (loose.count(key) != 0) continue;  // where the graph cannot place it yet: not drawn

@@ -19,6 +19,7 @@
 #include "daemon/pipeline/estimation_stage.h"
 #include "daemon/pipeline/graph_stage_options.h"
 #include "daemon/pipeline/latency_histogram.h"
+#include "daemon/pipeline/robot_trajectories.h"
 #include "daemon/pipeline/team_input.h"
 #include "daemon/telemetry/graph_scene.h"
 #include "estimation/eval/trajectory.h"
@@ -90,12 +91,6 @@ struct OriginEstimate {
   bool has_covariance = false;
   bool connected = true;  // to the robot's prior
 };
-
-// The graph key of the plane landmark named by its first observation: plane `plane` of the
-// submap at graph frame index `frame` of robot `letter`.
-uint64_t PlaneLandmarkKey(char letter, uint64_t frame, uint32_t plane);
-// The same for the line landmark named by edge `line` (< 1024) of a submap.
-uint64_t LineLandmarkKey(char letter, uint64_t frame, uint32_t line);
 
 class GraphStage {
  public:
@@ -180,7 +175,9 @@ class GraphStage {
   GraphStageReport report() const;
   char robot() const { return robot_; }
   // Time of the last estimate placed, and the number of submap origins (cheap, for live updates).
-  Timestamp last_time() const { return estimates_.empty() ? Timestamp() : estimates_.back().time; }
+  Timestamp last_time() const {
+    return trajectories_.Own().empty() ? Timestamp() : trajectories_.Own().back().time;
+  }
   uint64_t submap_origins() const { return report_.submap_origins; }
   uint64_t factors_added() const { return report_.factors; }
   // Whether the last estimate taken became graph pose `*index` (a factor v).
@@ -206,8 +203,7 @@ class GraphStage {
   void OnFrameSwitch(const FrameSwitchEvent& e);
   bool Add(const SlamFactor& f);
   void Update();
-  static SlamFactor PlaneFactor(const TeamPlaneObservation& o);
-  static SlamFactor LineFactor(const TeamLineObservation& o);
+  Expected<double> StructureObservationChi2(const Expected<SlamFactor>& f) const;
   Status AddPlaneObservationNoUpdate(const TeamPlaneObservation& o);
   Status AddLineObservationNoUpdate(const TeamLineObservation& o);
   // Adds each observation with `add_one`, then updates the graph once if any was taken.
@@ -227,18 +223,8 @@ class GraphStage {
   uint64_t next_pose_ = 0;
   bool last_estimate_is_pose_ = false;
   uint64_t last_pose_index_ = 0;
-  struct Placed {
-    Timestamp time;
-    uint64_t frame_id = 0;
-    Eigen::Isometry3d T_frame_body = Eigen::Isometry3d::Identity();
-  };
-  std::vector<Placed> estimates_;
+  RobotTrajectories trajectories_;
   using RunKey = std::pair<char, uint32_t>;  // a robot's letter and run (see RunIndex)
-  std::map<RunKey, std::vector<Placed>> team_estimates_;  // of every run but this robot's current one
-  const std::vector<Placed>* Estimates(char robot, uint32_t run) const;
-  // The run of `robot` that was under way at `time`: of those started by then, the latest.
-  uint32_t RunAt(char robot, Timestamp time) const;
-  uint32_t LatestRun(char robot) const;
   struct PendingMatch {
     char robot_a, robot_b;
     uint64_t frame_a, frame_b;
@@ -254,26 +240,18 @@ class GraphStage {
   std::vector<TeamLineObservation> pending_lines_;
   void RetryPendingLines();
   // Detections.
-  struct PoseCovariance {
-    Timestamp time;
-    uint64_t frame_id = 0;
-    Matrix6d covariance = Matrix6d::Zero();
-  };
-  std::map<RunKey, std::vector<PoseCovariance>> pose_covariances_;  // of the graph poses, by run
-  enum class PoseLookup { kReady, kWait, kNever };
-  // `robot`'s pose at `time` in its frame, and the covariance for its factor v.
-  PoseLookup PoseAt(char robot, uint32_t run, Timestamp time, Placed* pose, Matrix6d* covariance,
-                    std::string* why) const;
   // Adds the pose variable of `robot` at `time` (once) with its factor v; returns its key.
-  uint64_t DetectionPose(char robot, uint32_t run, Timestamp time, const Placed& pose, const Matrix6d& covariance);
+  uint64_t DetectionPose(char robot, uint32_t run, Timestamp time, const PlacedEstimate& pose,
+                         const Matrix6d& covariance);
   void RetryPendingDetections();
   void RetryPendingFixes();
   GnssFixFactors gnss_;
   std::vector<TeamGnssFix> pending_fixes_;
   // Whether a sighting of a robot agrees with both robots' gravity (their estimates' roll and
   // pitch); if only IPPE's other minimum does, `T_observer_observed` becomes it and `chosen` says so.
-  bool AgreesWithGravity(const TeamDetection& d, const Placed& observer, const Placed& observed,
-                         Eigen::Isometry3d* T_observer_observed, std::string* chosen, std::string* refused);
+  bool AgreesWithGravity(const TeamDetection& d, const PlacedEstimate& observer,
+                         const PlacedEstimate& observed, Eigen::Isometry3d* T_observer_observed,
+                         std::string* chosen, std::string* refused);
   std::vector<std::string> landmarks_;
   std::vector<DetectionRecord> detection_records_;
   std::vector<size_t> pending_detections_;  // indices into detection_records_
