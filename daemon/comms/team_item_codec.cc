@@ -63,8 +63,8 @@ void SetPair(const TeamMatch& m, exchange::MatchAttemptItem* out) {
 }
 
 // The robots, runs and frames an observation names (the same fields in both landmark kinds).
-template <class Message, class Observation>
-void SetNames(const Observation& o, Message* p) {
+template <class Message>
+void SetNames(const TeamLandmarkNames& o, Message* p) {
   p->set_observer(o.observer);
   p->set_observer_incarnation(o.observer_incarnation);
   p->set_frame(o.frame);
@@ -73,9 +73,9 @@ void SetNames(const Observation& o, Message* p) {
   p->set_creator_frame(o.creator_frame);
 }
 
-template <class Message, class Observation>
+template <class Message>
 Status GetNames(const Message& p, const TeamItemCodec::Names& names, const std::string& which,
-                Observation* o) {
+                TeamLandmarkNames* o) {
   if (p.observer().empty() || p.creator().empty() || p.observer().size() > 64 || p.creator().size() > 64)
     return DataLossError(which + " names no observer or no creator robot");
   o->observer = p.observer();

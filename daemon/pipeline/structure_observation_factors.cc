@@ -17,8 +17,7 @@ uint64_t StructureLandmarkKey(VariableKind kind, char letter, uint64_t frame, ui
 }
 
 // Both robots in the team, both indices (the landmark's and the observer's) in range.
-template <class Observation>
-Status CheckNaming(const Observation& o, uint32_t index, uint32_t observer_index, uint32_t max,
+Status CheckNaming(const TeamLandmarkNames& o, uint32_t index, uint32_t observer_index, uint32_t max,
                    const std::string& what) {
   if (o.observer_letter == 0 || o.creator_letter == 0) {
     return InvalidArgumentError(what + " observation naming a robot not in the team");

@@ -91,21 +91,26 @@ struct TeamGnssFix {
   Eigen::Vector3d antenna = Eigen::Vector3d::Zero();
 };
 
+// Who observed a landmark and who named it: submap `frame` of `observer`, and `creator`'s submap
+// `creator_frame`, whose face or edge first observed it (both landmark kinds).
+struct TeamLandmarkNames {
+  std::string observer;               // robot names
+  char observer_letter = 0;           // graph letters (from the team file)
+  uint32_t observer_incarnation = 0;  // the runs (on the wire; decoded frames include them)
+  uint64_t frame = 0;
+  std::string creator;
+  char creator_letter = 0;
+  uint32_t creator_incarnation = 0;
+  uint64_t creator_frame = 0;
+};
+
 // A plane landmark observation o: submap `frame` of `observer` saw the landmark named by its first
 // observation (plane `plane` of `creator`'s submap `creator_frame`), measured in the submap's
 // gravity-aligned frame as normal . p + offset = 0, with `covariance` that of (a, b, d) in
 // SubmapPlane's tangent axes, and `centroid` (in the submap's frame) where the landmark is placed
 // when this observation creates it.
-struct TeamPlaneObservation {
-  std::string observer;               // robot names
-  char observer_letter = 0;           // graph letters (from the team file)
-  uint32_t observer_incarnation = 0;  // the runs (on the wire; decoded frames include them)
-  uint64_t frame = 0;
+struct TeamPlaneObservation : TeamLandmarkNames {
   uint32_t observer_plane = 0;  // index in the observer's submap
-  std::string creator;
-  char creator_letter = 0;
-  uint32_t creator_incarnation = 0;
-  uint64_t creator_frame = 0;
   uint32_t plane = 0;
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   double offset = 0.0;  // m
@@ -117,16 +122,8 @@ struct TeamPlaneObservation {
 // of the submap, the line through `point` (the edge's middle, in the submap's gravity-aligned
 // frame) along unit `direction`, with `covariance` that of line_factors.h's error (rad, rad, m,
 // m); the landmark is named by edge `line` of `creator`'s submap `creator_frame`.
-struct TeamLineObservation {
-  std::string observer;
-  char observer_letter = 0;
-  uint32_t observer_incarnation = 0;
-  uint64_t frame = 0;
+struct TeamLineObservation : TeamLandmarkNames {
   uint32_t observer_line = 0;
-  std::string creator;
-  char creator_letter = 0;
-  uint32_t creator_incarnation = 0;
-  uint64_t creator_frame = 0;
   uint32_t line = 0;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
