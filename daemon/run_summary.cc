@@ -168,6 +168,7 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
     j.Field("images_mapped", m.images_mapped);
     j.Field("images_without_pose", m.images_without_pose);
     j.Field("images_dropped", m.images_dropped);
+    j.Field("estimates_dropped", m.estimates_dropped);
     j.Field("errors", m.mapping_errors);
     j.Field("points", m.mapper.points).Field("obstacle_points", m.mapper.obstacle_points);
     j.Field("fused_pixels", m.mapper.fused_pixels).Field("unmapped_points", m.mapper.unmapped_points);

@@ -144,13 +144,22 @@ void MappingStage::OnPair(const RectifiedPair& pair) {
   }
 }
 
+void MappingStage::OnEstimate(const FrameEstimate& e) {
+  if (estimates_.full()) {
+    estimates_.Pop();
+    ++report_.estimates_dropped;
+  }
+  estimates_.Next() = e;
+  estimates_.Push();
+}
+
 void MappingStage::ProcessReady(bool final) {
   while (!waiting_.empty()) {
     const DepthImage& image = waiting_.Front();
-    while (!estimates_.empty() && estimates_.front().time < image.time) estimates_.pop_front();
+    while (!estimates_.empty() && estimates_.Front().time < image.time) estimates_.Pop();
     if (estimates_.empty() && !final) return;  // its estimate is still to come
-    if (!estimates_.empty() && estimates_.front().time == image.time && estimates_.front().valid) {
-      Map(image, estimates_.front());
+    if (!estimates_.empty() && estimates_.Front().time == image.time && estimates_.Front().valid) {
+      Map(image, estimates_.Front());
     } else {
       ++report_.images_without_pose;
     }

@@ -61,6 +61,7 @@ struct MappingStageReport {
   uint64_t images_mapped = 0;
   uint64_t images_without_pose = 0;  // no valid filter estimate at the exposure
   uint64_t images_dropped = 0;       // waiting images pushed out by newer ones
+  uint64_t estimates_dropped = 0;    // estimates pushed out while no image waited for them
   uint64_t mapping_errors = 0;
   uint64_t frame_switches = 0;       // switches applied to the mapper
   uint64_t switch_requests = 0;      // partitioning's requests to the filter
@@ -89,7 +90,7 @@ class MappingStage {
 
   // Dense stereo on one rectified pair; its depth image waits for its pose.
   void OnPair(const RectifiedPair& pair);
-  void OnEstimate(const FrameEstimate& e) { estimates_.push_back(e); }
+  void OnEstimate(const FrameEstimate& e);
   void OnFrameSwitch(const FrameSwitchEvent& e) { switches_.push_back(e); }
   // Maps every waiting image whose estimate is known. `final`: no more estimates will come.
   void ProcessReady(bool final);
@@ -143,7 +144,10 @@ class MappingStage {
   // slot more, to convert a pair into before the oldest image is given up for it.
   static constexpr size_t kWaitingImages = 16;
   ReuseRing<DepthImage, kWaitingImages + 1> waiting_;
-  std::deque<FrameEstimate> estimates_;
+  // Estimates wait only while no image does (ProcessReady gives up those older than the first
+  // image): more than this is seconds of frames without an image, and the oldest is of no use.
+  static constexpr size_t kWaitingEstimates = 256;
+  ReuseRing<FrameEstimate, kWaitingEstimates> estimates_;
   std::deque<FrameSwitchEvent> switches_;
   LatencyHistogram match_time_, map_time_, line_time_;
   MappingStageReport report_;

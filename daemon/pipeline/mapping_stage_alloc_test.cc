@@ -1,6 +1,6 @@
 // Proves that dense stereo on a pair, its depth image and its edges allocate nothing once the
-// mapping stage has held as many images of the size as ever wait at once (the binary counts
-// allocations).
+// mapping stage has held as many images of the size as ever wait at once, and that estimates
+// never allocate (the binary counts allocations).
 
 #include <algorithm>
 #include <cstdint>
@@ -84,14 +84,38 @@ TEST(MappingStageAllocationTest, APairAllocatesNothingOnceTheWaitingSlotsAreGrow
       << "the pairs must have edges for this test to hold; detected " << (*stage)->report().line_segments;
   for (; k < 60; ++k) {
     const RectifiedPair pair = (k % 2 == 0 ? a : b).Pair(k);
+    FrameEstimate estimate;
+    estimate.time = pair.time + Duration::Milliseconds(1);  // no image's: they keep waiting
     testing::CountingAllocator::Arm();
     (*stage)->OnPair(pair);
+    (*stage)->OnEstimate(estimate);
     const long counted = testing::CountingAllocator::Disarm();
     EXPECT_EQ(counted, 0) << "pair " << k;
   }
   EXPECT_EQ((*stage)->report().pairs, 60u);
   EXPECT_EQ((*stage)->report().match_failures, 0u);
   EXPECT_EQ((*stage)->report().images_dropped, 60u - 16u);
+}
+
+TEST(MappingStageAllocationTest, EstimatesWithoutImagesWaitInABoundedRing) {
+  MappingSetup setup;
+  setup.mapping.enabled = true;
+  setup.mapping.write_submaps = false;
+  setup.stereo.sgm.num_disparities = 64;
+  setup.camera.width = kAllocWidth;
+  setup.camera.height = kAllocHeight;
+  setup.camera.f = 300.0;
+  setup.camera.baseline = 0.12;
+  auto stage = MappingStage::Create(setup, nullptr);
+  ASSERT_TRUE(stage.ok()) << stage.status().ToString();
+  for (int64_t k = 0; k < 300; ++k) {
+    FrameEstimate e;
+    e.time = Timestamp::FromNanoseconds(k * 50'000'000);
+    testing::CountingAllocator::Arm();
+    (*stage)->OnEstimate(e);
+    EXPECT_EQ(testing::CountingAllocator::Disarm(), 0) << "estimate " << k;
+  }
+  EXPECT_EQ((*stage)->report().estimates_dropped, 300u - 256u);
 }
 
 }  // namespace
