@@ -8,11 +8,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <numeric>
 #include <string>
 #include <vector>
 
 #include "mapping/matching/line_associator.h"
-#include "mapping/matching/unambiguous_pairs.h"
+#include "mapping/matching/testing/every_line_pairing.h"
+#include "mapping/matching/testing/placements.h"
 #include "tools/commands.h"
 #include "tools/sample_median.h"
 #include "tools/submap_truth.h"
@@ -26,32 +28,6 @@ double LandmarkMs(LandmarkClock::time_point a, LandmarkClock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-SubmapPlacement PlacedAt(const SubmapWithTruth& s, double sigma_t, double sigma_r) {
-  SubmapPlacement p;
-  p.T_world_submap = s.T_world_submap.ToIsometry();
-  Eigen::Matrix<double, 6, 1> d;
-  d << sigma_t, sigma_t, sigma_t, sigma_r, sigma_r, sigma_r;
-  p.covariance = d.cwiseAbs2().asDiagonal();
-  return p;
-}
-
-// What LineAssociator::Associate decided before it bounded the distances: every pairing's.
-std::vector<LineAssociation> EveryLinePairing(const LineAssociator& associator,
-                                              const LineAssociationOptions& o,
-                                              const std::vector<SubmapLine>& a, const SubmapPlacement& pa,
-                                              const std::vector<SubmapLine>& b, const SubmapPlacement& pb) {
-  std::vector<LineAssociation> candidates;
-  for (size_t i = 0; i < a.size(); ++i) {
-    if (!associator.Eligible(a[i])) continue;
-    for (size_t j = 0; j < b.size(); ++j) {
-      if (!associator.Eligible(b[j])) continue;
-      candidates.push_back(
-          LineAssociation{static_cast<int>(i), static_cast<int>(j), associator.Distance(a[i], pa, b[j], pb)});
-    }
-  }
-  return UnambiguousPairs(candidates, o.gate_chi2, o.ambiguity_chi2);
-}
-
 bool SameDecisions(const std::vector<LineAssociation>& x, const std::vector<LineAssociation>& y) {
   if (x.size() != y.size()) return false;
   for (size_t i = 0; i < x.size(); ++i) {
@@ -62,11 +38,8 @@ bool SameDecisions(const std::vector<LineAssociation>& x, const std::vector<Line
 
 void PrintLandmarkTimes(const char* name, const std::vector<double>& ms) {
   std::printf("  %-34s median %7.3f ms, p90 %7.3f ms, max %7.3f ms, sum %8.1f ms\n", name, Median(ms),
-              NearestRankPercentile(ms, 0.9), NearestRankPercentile(ms, 1.0), [&] {
-                double sum = 0.0;
-                for (double v : ms) sum += v;
-                return sum;
-              }());
+              NearestRankPercentile(ms, 0.9), NearestRankPercentile(ms, 1.0),
+              std::accumulate(ms.begin(), ms.end(), 0.0));
 }
 
 }  // namespace
@@ -120,13 +93,12 @@ int RunBenchLandmarks(const CommandArgs& args) {
   }
   const LineAssociationOptions line_options;
   const LineAssociator lines(line_options);
-  auto eligible_lines = [&](const Submap& s) {
-    return std::count_if(s.structure().lines.begin(), s.structure().lines.end(),
-                         [&](const SubmapLine& l) { return lines.Eligible(l); });
-  };
   std::vector<double> edges_per_submap;
-  for (const SubmapWithTruth& s : submaps)
-    edges_per_submap.push_back(static_cast<double>(eligible_lines(*s.submap)));
+  for (const SubmapWithTruth& s : submaps) {
+    const std::vector<SubmapLine>& l = s.submap->structure().lines;
+    edges_per_submap.push_back(static_cast<double>(
+        std::count_if(l.begin(), l.end(), [&](const SubmapLine& x) { return lines.Eligible(x); })));
+  }
 
   std::vector<double> bounded_ms, every_ms, ratios;
   size_t pairings = 0, beyond = 0, differing = 0, paired = 0;
@@ -134,12 +106,13 @@ int RunBenchLandmarks(const CommandArgs& args) {
   for (size_t i = 0; i < submaps.size(); ++i) {
     for (size_t j = i + 1; j < submaps.size(); ++j) {
       const SubmapWithTruth &a = submaps[i], &b = submaps[j];
-      const SubmapPlacement pa = PlacedAt(a, sigma_t, sigma_r), pb = PlacedAt(b, sigma_t, sigma_r);
+      const SubmapPlacement pa = testing::PlacedWithSigma(a.T_world_submap.ToIsometry(), sigma_t, sigma_r);
+      const SubmapPlacement pb = testing::PlacedWithSigma(b.T_world_submap.ToIsometry(), sigma_t, sigma_r);
       if ((pa.T_world_submap.translation() - pb.T_world_submap.translation()).head<2>().norm() > reach)
         continue;
       const std::vector<SubmapLine>& la = a.submap->structure().lines;
       const std::vector<SubmapLine>& lb = b.submap->structure().lines;
-      if (eligible_lines(*a.submap) == 0 || eligible_lines(*b.submap) == 0) continue;
+      if (edges_per_submap[i] == 0.0 || edges_per_submap[j] == 0.0) continue;
       std::vector<double> bounded, every;
       std::vector<LineAssociation> fast, slow;
       for (int r = 0; r < repeats; ++r) {
@@ -150,7 +123,7 @@ int RunBenchLandmarks(const CommandArgs& args) {
             fast = lines.Associate(la, pa, lb, pb);
             bounded.push_back(LandmarkMs(t0, LandmarkClock::now()));
           } else {
-            slow = EveryLinePairing(lines, line_options, la, pa, lb, pb);
+            slow = testing::EveryLinePairing(lines, line_options, la, pa, lb, pb);
             every.push_back(LandmarkMs(t0, LandmarkClock::now()));
           }
         }
@@ -184,14 +157,9 @@ int RunBenchLandmarks(const CommandArgs& args) {
               bounded_ms.size(), pairings);
   PrintLandmarkTimes("bounded (LineAssociator)", bounded_ms);
   PrintLandmarkTimes("baseline: every pairing's distance", every_ms);
-  std::printf("  ratio baseline / bounded, per pair: median %.1f; of the sums %.1f\n", Median(ratios), [&] {
-    double x = 0.0, y = 0.0;
-    for (size_t k = 0; k < every_ms.size(); ++k) {
-      x += every_ms[k];
-      y += bounded_ms[k];
-    }
-    return x / std::max(1e-6, y);
-  }());
+  std::printf("  ratio baseline / bounded, per pair: median %.1f; of the sums %.1f\n", Median(ratios),
+              std::accumulate(every_ms.begin(), every_ms.end(), 0.0) /
+                  std::max(1e-6, std::accumulate(bounded_ms.begin(), bounded_ms.end(), 0.0)));
   std::printf("  pairings put beyond reach (chi2 %.2f) by the bound alone: %zu of %zu (%.1f %%)\n",
               line_reach, beyond, pairings,
               100.0 * static_cast<double>(beyond) / static_cast<double>(std::max<size_t>(1, pairings)));

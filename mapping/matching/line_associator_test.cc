@@ -8,8 +8,8 @@
 
 #include "estimation/math/ordered_draws.h"
 #include "estimation/math/tangent_axes.h"
+#include "mapping/matching/testing/every_line_pairing.h"
 #include "mapping/matching/testing/placements.h"
-#include "mapping/matching/unambiguous_pairs.h"
 #include "mapping/testing/submap_edges.h"
 
 namespace cairn {
@@ -308,14 +308,7 @@ TEST(LineAssociatorTest, DecidesAsTheSearchOfEveryPairing) {
     const SubmapPlacement pa = testing::PlacedWithSigma(a, 0.05, 0.005);
     const SubmapPlacement pb =
         testing::PlacedWithSigma(b, d.LogUniform(0.01, 0.5), d.LogUniform(0.001, 0.05));
-    std::vector<LineAssociation> every;
-    for (size_t i = 0; i < la.size(); ++i) {
-      for (size_t j = 0; j < lb.size(); ++j) {
-        every.push_back(LineAssociation{static_cast<int>(i), static_cast<int>(j),
-                                        associator.Distance(la[i], pa, lb[j], pb)});
-      }
-    }
-    const auto expected = UnambiguousPairs(every, options.gate_chi2, options.ambiguity_chi2);
+    const auto expected = testing::EveryLinePairing(associator, options, la, pa, lb, pb);
     const auto pairs = associator.Associate(la, pa, lb, pb);
     ASSERT_EQ(pairs.size(), expected.size()) << "world " << k;
     for (size_t i = 0; i < pairs.size(); ++i) {
