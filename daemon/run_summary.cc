@@ -225,7 +225,7 @@ std::string BuildSummaryJson(const RunInfo& run, const Pipeline& p) {
   if (const SubmapMatchingStage* matching = p.matching()) {
     const SubmapMatchingReport m = matching->report();
     j.Key("matching").BeginObject();
-    j.Field("submaps", m.submaps).Field("suitable", m.suitable);
+    j.Field("submaps", m.submaps).Field("suitable", m.suitable).Field("searchable", m.searchable);
     j.Field("attempts", m.attempts).Field("matched", m.matched).Field("accepted", m.accepted);
     j.Key("pairs").BeginObject();
     for (const auto& [why, count] : m.pairs) j.Field(why, count);

@@ -8,10 +8,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <numeric>
 #include <optional>
-#include <unordered_set>
 #include <sstream>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include "common/json_writer.h"
@@ -58,6 +59,8 @@ void WriteFeatures(JsonWriter& j, const char* key, const std::string& path, cons
   j.Field("file", path);
   j.Field("suitable", f.suitable());
   j.Field("suitability", f.suitability.message);
+  j.Field("searchable", f.searchable);
+  j.Field("ground_area_m2", f.ground_area);
   j.Field("points", f.suitability.points);
   j.Field("obstacle_points", f.suitability.obstacle_points);
   j.Field("keypoints", f.keypoints.points.size());
@@ -110,12 +113,15 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
   return total == 0 ? 0.0 : static_cast<double>(near) / static_cast<double>(total);
 }
 
+// Which pairs the bench tries, by whether their submaps are suitable for the descriptors.
+enum class SearchOnly { kNone, kWith, kOnly };
+
 }  // namespace
 
 constexpr const char* kBenchMatchUsage =
     "usage: cairn bench match OUT_DIR... [--min-overlap F (0.3)] [--wire-bits OFFSET,INTENSITY]\n"
     "                         [--no-photometric] [--no-grey-search] [--no-grey-refinement]\n"
-    "                         [--no-planes] [--no-lines] [--dof 4|6]\n"
+    "                         [--no-planes] [--no-lines] [--dof 4|6] [--suitable-only | --search-only]\n"
     "  OUT_DIR: cairnd output folders of simulated runs of one world (submaps/ with index.csv)\n"
     "  --wire-bits: first send every submap through the wire format at these bit counts\n"
     "               (mapping.submap.wire_offset_bits 1..4, wire_intensity_bits 1..8)\n"
@@ -124,7 +130,9 @@ constexpr const char* kBenchMatchUsage =
     "  --no-grey-refinement: the ICP's x, y and yaw as they are (not moved to the grey levels' best)\n"
     "  --no-planes: no hypotheses from pairs of the submaps' planar faces\n"
     "  --no-lines: no hypotheses from pairs of the submaps' straight edges\n"
-    "  --dof 6: the matcher's variant without gravity; a match must then also be level within 0.5 deg\n";
+    "  --dof 6: the matcher's variant without gravity; a match must then also be level within 0.5 deg\n"
+    "  --suitable-only: only pairs of submaps suitable for the descriptors (thesis 6.1.1)\n"
+    "  --search-only: only pairs with a submap kept for the grey-level search alone\n";
 
 int RunBenchMatch(const CommandArgs& args) {
   if (WantsHelp(args)) return PrintUsage(kBenchMatchUsage);
@@ -133,6 +141,7 @@ int RunBenchMatch(const CommandArgs& args) {
   std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
   SubmapMatcherOptions matcher_options;
   ShotFrame frame = ShotFrame::kGravity;
+  SearchOnly search_only = SearchOnly::kWith;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     std::vector<double> v;
@@ -154,6 +163,10 @@ int RunBenchMatch(const CommandArgs& args) {
       matcher_options.planes.enabled = false;
     } else if (a == "--no-lines") {
       matcher_options.lines.enabled = false;
+    } else if (a == "--suitable-only") {
+      search_only = SearchOnly::kNone;
+    } else if (a == "--search-only") {
+      search_only = SearchOnly::kOnly;
     } else if (a == "--dof" && i + 1 < args.args.size() &&
                (args.args[i + 1] == std::string("4") || args.args[i + 1] == std::string("6"))) {
       frame = args.args[++i] == std::string("6") ? ShotFrame::kFull : ShotFrame::kGravity;
@@ -194,25 +207,31 @@ int RunBenchMatch(const CommandArgs& args) {
   }
   const SubmapFeatureExtractor extractor({}, frame);
   std::vector<double> feature_ms;
-  size_t suitable = 0;
+  size_t suitable = 0, searchable = 0;
   for (IndexedSubmap& s : submaps) {
     s.features = extractor.Extract(*s.submap);
     feature_ms.push_back(s.features.keypoint_ms + s.features.descriptor_ms);
     suitable += s.features.suitable();
+    searchable += s.features.searchable;
   }
-  std::printf("cairn bench match: %zu submaps with true origins from %zu folders, %zu suitable\n", submaps.size(),
-              dirs.size(), suitable);
+  std::printf(
+      "cairn bench match: %zu submaps with true origins from %zu folders, %zu suitable, %zu for the "
+      "grey-level "
+      "search only\n",
+      submaps.size(), dirs.size(), suitable, searchable);
   std::printf("  keypoints + descriptors per submap: median %.1f ms, max %.1f ms\n", Median(feature_ms),
               feature_ms.empty() ? NAN : *std::max_element(feature_ms.begin(), feature_ms.end()));
   const SubmapMatcher matcher(matcher_options);
-  std::vector<double> match_ms, good_error_m, good_error_deg;
+  std::vector<double> match_ms, good_error_m, good_error_deg, nees;
   size_t positives = 0, found = 0, matched = 0, correct = 0, negatives = 0, false_matches = 0;
   for (size_t i = 0; i < submaps.size(); ++i) {
     for (size_t j = i + 1; j < submaps.size(); ++j) {
       const IndexedSubmap& a = submaps[i];
       const IndexedSubmap& b = submaps[j];
       if (a.robot == b.robot && (a.id + 1 == b.id || b.id + 1 == a.id)) continue;
-      if (!a.features.suitable() || !b.features.suitable()) continue;
+      if (!a.features.matchable() || !b.features.matchable()) continue;
+      if (search_only == SearchOnly::kNone && (!a.features.suitable() || !b.features.suitable())) continue;
+      if (search_only == SearchOnly::kOnly && a.features.suitable() && b.features.suitable()) continue;
       const FourDofTransform truth = a.T_world_submap.inverse() * b.T_world_submap;
       const double overlap = std::max(TrueOverlap(*a.submap, *b.submap, truth),
                                       TrueOverlap(*b.submap, *a.submap, truth.inverse()));
@@ -223,6 +242,12 @@ int RunBenchMatch(const CommandArgs& args) {
                         r.tilt <= 0.5 * M_PI / 180;
       matched += r.matched();
       correct += good;
+      if (r.matched()) {
+        // The matcher's covariance against its actual error (x, y, z, yaw in A's axes).
+        Eigen::Vector4d d = r.T_a_b.ToVector() - truth.ToVector();
+        d[3] = WrapAngle(d[3]);
+        nees.push_back(d.dot(r.covariance.ldlt().solve(d)));
+      }
       if (good) {
         good_error_m.push_back(error.translation().norm());
         good_error_deg.push_back(std::abs(error.yaw()) * 180 / M_PI);
@@ -256,6 +281,11 @@ int RunBenchMatch(const CommandArgs& args) {
               Median(good_error_deg),
               good_error_m.empty() ? NAN : *std::max_element(good_error_m.begin(), good_error_m.end()),
               good_error_deg.empty() ? NAN : *std::max_element(good_error_deg.begin(), good_error_deg.end()));
+  const double nees_mean =
+      nees.empty() ? NAN : std::accumulate(nees.begin(), nees.end(), 0.0) / static_cast<double>(nees.size());
+  std::printf(
+      "  NEES of every match (4 where the covariance is right): mean %.1f, median %.1f over %zu matches\n",
+      nees_mean, Median(nees), nees.size());
   return 0;
 }
 

@@ -253,9 +253,12 @@ int RunSummary(const CommandArgs& args) {
       }
       if (s.has("matching")) {
         const JsonValue& m = s["matching"];
-        std::printf("  matching: %.0f submaps (%.0f suitable), %.0f attempts, %.0f matched, %.0f in the graph",
-                    m["submaps"].number(), m["suitable"].number(), m["attempts"].number(), m["matched"].number(),
-                    m["accepted"].number());
+        std::printf(
+            "  matching: %.0f submaps (%.0f suitable, %.0f for the grey-level search only), %.0f attempts, "
+            "%.0f matched, %.0f in the graph",
+            m["submaps"].number(), m["suitable"].number(),
+            m.has("searchable") ? m["searchable"].number() : 0.0, m["attempts"].number(),
+            m["matched"].number(), m["accepted"].number());
         if (m.has("pairs")) {
           const char* sep = "; pairs: ";
           for (const auto& [why, count] : m["pairs"].object()) {

@@ -162,8 +162,8 @@ void SubmapMatchingStage::RefreshEstimates(GraphStage& graph) {
     if (f == features_.end()) continue;
     PairingSubmap p;
     p.key = f->first;
-    p.suitable = f->second->suitable();
-    p.obstacle_box_xy = f->second->obstacle_box_xy;
+    p.suitable = f->second->matchable();
+    p.obstacle_box_xy = f->second->match_box_xy();
     p.placed = o.has_covariance;
     // Robots not tied to this one each float on their own (two of them may be tied to each other;
     // the pairing then tries a global search where a prior would do, never the reverse).
@@ -181,6 +181,7 @@ void SubmapMatchingStage::Take(Done done, GraphStage& graph) {
     const SubmapFeatures& f = *done.features;
     features_time_.Record(Duration::Seconds((f.keypoint_ms + f.descriptor_ms) * 1e-3));
     if (f.suitable()) ++report_.suitable;
+    if (f.searchable) ++report_.searchable;
     features_[done.job.key] = done.features;
     estimates_stale_ = true;
     return;

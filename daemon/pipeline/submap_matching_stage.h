@@ -41,6 +41,7 @@ struct MatchAttempt {
 struct SubmapMatchingReport {
   uint64_t submaps = 0;
   uint64_t suitable = 0;
+  uint64_t searchable = 0;  // unsuitable for descriptors, kept for the grey-level search
   uint64_t attempts = 0;
   uint64_t matched = 0;
   uint64_t accepted = 0;   // factors the graph took

@@ -1,11 +1,32 @@
 #include "mapping/matching/submap_feature_extractor.h"
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <unordered_set>
 
 #include "common/elapsed.h"
 #include "common/heap_bytes.h"
 
 namespace cairn {
+namespace {
+
+// The grey-level search's default raster cell.
+constexpr double kSearchCell = 0.2;  // m
+
+// Area of the xy cells of kSearchCell that hold at least one point.
+double GroundArea(const std::vector<Eigen::Vector3d>& cloud) {
+  std::unordered_set<uint64_t> cells;
+  cells.reserve(cloud.size() / 4);
+  for (const Eigen::Vector3d& p : cloud) {
+    const auto x = static_cast<int64_t>(std::floor(p.x() / kSearchCell));
+    const auto y = static_cast<int64_t>(std::floor(p.y() / kSearchCell));
+    cells.insert(static_cast<uint64_t>(x) << 32 ^ (static_cast<uint64_t>(y) & 0xffffffffu));
+  }
+  return static_cast<double>(cells.size()) * kSearchCell * kSearchCell;
+}
+
+}  // namespace
 
 size_t SubmapFeatures::memory_bytes() const {
   return sizeof(*this) + HeapBytes(keypoints.points, keypoints.known_fraction, described.points,
@@ -25,6 +46,7 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
     f.cloud.push_back(c.p.cast<double>());
     f.cloud_grey.push_back(static_cast<float>(c.r + c.g + c.b) / 3.0f);
     if (c.obstacle) f.obstacle_box_xy.extend(c.p.head<2>().cast<double>());
+    f.cloud_box_xy.extend(c.p.head<2>().cast<double>());
   }
   if (f.suitability.suitable()) {
     f.keypoints = KeypointExtractor(options_.keypoints).Extract(submap);
@@ -32,7 +54,19 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
   }
   f.keypoint_ms = MillisecondsSince(start);
   if (!f.suitability.suitable()) {
-    // Never aligned, but kept for the whole mission: most submaps of a rover on open ground.
+    // The search turns about gravity: only for the 4-DoF matcher's features.
+    if (f.suitability.reason != SuitabilityReason::kTooFewPoints && frame_ == ShotFrame::kGravity &&
+        options_.min_search_area > 0.0) {
+      f.ground_area = GroundArea(f.cloud);
+      f.searchable = f.ground_area >= options_.min_search_area;
+    }
+    f.keypoint_ms = MillisecondsSince(start);
+    if (f.searchable) {
+      f.cloud.shrink_to_fit();
+      f.cloud_grey.shrink_to_fit();
+      return f;
+    }
+    // Never aligned, but kept for the whole mission.
     f.cloud = std::vector<Eigen::Vector3d>();  // frees it (assigning {} would keep the capacity)
     f.cloud_grey = std::vector<float>();
     return f;

@@ -178,8 +178,14 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     return r;
   };
   if (Status s = options_.Validate(); !s.ok()) return finish(MatchStatus::kNoMatch, s.message());
-  if (!a.suitable()) return finish(MatchStatus::kUnsuitable, "submap A: " + a.suitability.message);
-  if (!b.suitable()) return finish(MatchStatus::kUnsuitable, "submap B: " + b.suitability.message);
+  // A submap the descriptors cannot use may still be matched by the grey-level search alone.
+  const bool search_only = !a.suitable() || !b.suitable();
+  for (const SubmapFeatures* side : {&a, &b}) {
+    if (side->matchable() && (side->suitable() || options_.grey_search.enabled)) continue;
+    return finish(MatchStatus::kUnsuitable, std::string(side == &a ? "submap A: " : "submap B: ") +
+                                                side->suitability.message +
+                                                (side->searchable ? "; the grey-level search is off" : ""));
+  }
   const bool six = !a.described.gravity_frames;
   r.dof = six ? 6 : 4;
   if (a.described.gravity_frames != b.described.gravity_frames)
@@ -188,11 +194,15 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   // Correspondences and votes.
   Clock::time_point stage = Clock::now();
   const std::vector<KeypointCorrespondence> correspondences =
-      CorrespondenceFinder(options_.correspondences).Find(a.described.descriptors, b.described.descriptors);
+      search_only ? std::vector<KeypointCorrespondence>()
+                  : CorrespondenceFinder(options_.correspondences)
+                        .Find(a.described.descriptors, b.described.descriptors);
   r.correspondences = correspondences.size();
   r.times.correspondences_ms = MillisecondsSince(stage);
   stage = Clock::now();
-  const HoughResult votes = HoughVoting(options_.hough).Vote(a.described, b.described, correspondences);
+  const HoughResult votes = search_only
+                                ? HoughResult()
+                                : HoughVoting(options_.hough).Vote(a.described, b.described, correspondences);
   r.clusters = votes.clusters.size();
   r.times.hough_ms = MillisecondsSince(stage);
 
@@ -300,8 +310,16 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
     hypotheses.push_back(std::move(h));
   }
   r.times.ransac_ms = MillisecondsSince(stage);
-  if (votes.clusters.empty())
+  if (search_only) {
+    const SubmapFeatures& unsuitable = a.suitable() ? b : a;
+    rejections.Add("no descriptors", Format("%s unsuitable for descriptors (%s): grey-level search only",
+                                            !a.suitable() && !b.suitable() ? "submaps A and B"
+                                            : a.suitable()                 ? "submap B"
+                                                                           : "submap A",
+                                            unsuitable.suitability.message.c_str()));
+  } else if (votes.clusters.empty()) {
     rejections.Add("no vote cluster", Format("%zu correspondences, no vote cluster", correspondences.size()));
+  }
   std::stable_sort(hypotheses.begin(), hypotheses.end(), [](const Hypothesis& x, const Hypothesis& y) {
     return x.inliers > y.inliers || (x.inliers == y.inliers && x.rms < y.rms);
   });

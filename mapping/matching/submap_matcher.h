@@ -3,7 +3,9 @@
 // Hough voting both ways, a 4-DoF RANSAC per vote cluster, the gate against the graph's relative
 // estimate, the spread check of each hypothesis' keypoints, the photometric check of each
 // hypothesis (photometric_agreement.h), then point-to-plane 4-DoF ICP on the full clouds from the
-// best surviving hypothesis, gated and checked photometrically again.
+// best surviving hypothesis, gated and checked photometrically again. Where either submap is
+// unsuitable for the descriptors but kept for the grey-level search (SubmapFeatures::searchable),
+// only that search proposes hypotheses.
 //
 // The result is T_a_b (B's origin in A's frame) with its covariance from the ICP (x, y, z, yaw,
 // see four_dof_icp.h).
@@ -12,8 +14,9 @@
 // with full 3-D frames (SubmapFeatureExtractor with ShotFrame::kFull): Hough votes in x, y, z,
 // three-point RANSAC (six_dof_ransac.h) and a 6-DoF ICP (six_dof_icp.h), with the same gate,
 // spread and photometric checks and options. Gravity is then used nowhere; the result also holds
-// the full transform and its tilt, and T_a_b and the covariance are its x, y, z and yaw. Every rejection says which check failed and by how much, because matches
-// that fail are remembered by the pairing and shared with teammates.
+// the full transform and its tilt, and T_a_b and the covariance are its x, y, z and yaw. Every rejection says
+// which check failed and by how much, because matches that fail are remembered by the pairing and shared with
+// teammates.
 
 #include <cstdint>
 #include <optional>

@@ -317,13 +317,25 @@ TEST(SubmapMatcherSceneTest, NonFinitePointsAreSkipped) {
   for (const Eigen::Vector3d& p : fb.cloud) ASSERT_TRUE(p.allFinite());
 }
 
-TEST(SubmapMatcherSceneTest, UnsuitableSubmapsKeepNoCloud) {
+TEST(SubmapMatcherSceneTest, UnsuitableSubmapsKeepNoCloudUnlessSearchable) {
   // Without an occupancy tree no keypoint has known space around it.
   const testing::ScenePair pair = testing::OverlappingSubmaps(7);
   const auto b = std::make_shared<const Submap>(pair.b->metadata(), pair.b->points(),
                                                 MakeOccupancyTree(pair.b->metadata().options));
-  const SubmapFeatures fb = SubmapFeatureExtractor().Extract(*b);
+  const SubmapFeatures kept = SubmapFeatureExtractor().Extract(*b);
+  ASSERT_FALSE(kept.suitable());
+  EXPECT_TRUE(kept.searchable) << kept.ground_area;
+  EXPECT_TRUE(kept.matchable());
+  EXPECT_FALSE(kept.cloud.empty());
+  EXPECT_EQ(kept.cloud.size(), kept.cloud_grey.size());
+  EXPECT_TRUE(kept.described.descriptors.empty());
+
+  SubmapFeatureOptions never;
+  never.min_search_area = 0.0;
+  const SubmapFeatures fb = SubmapFeatureExtractor(never).Extract(*b);
   ASSERT_FALSE(fb.suitable());
+  EXPECT_FALSE(fb.searchable);
+  EXPECT_FALSE(fb.matchable());
   EXPECT_TRUE(fb.cloud.empty());
   EXPECT_EQ(fb.cloud.capacity(), 0u);
   EXPECT_FALSE(fb.obstacle_box_xy.isEmpty());  // still pairs by its extent
@@ -332,6 +344,73 @@ TEST(SubmapMatcherSceneTest, UnsuitableSubmapsKeepNoCloud) {
   ASSERT_TRUE(fa.suitable()) << fa.suitability.message;
   EXPECT_GE(fa.memory_bytes(), fa.cloud.size() * sizeof(Eigen::Vector3d) + fa.described.descriptors.size() * sizeof(GravityShot));
   EXPECT_LT(fb.memory_bytes(), fa.memory_bytes() / 10);
+
+  // More ground than the search could use is asked for: not kept either.
+  SubmapFeatureOptions large;
+  large.min_search_area = kept.ground_area + 1.0;
+  EXPECT_FALSE(SubmapFeatureExtractor(large).Extract(*b).searchable);
+}
+
+// Submaps of textured ground with no obstacles: the descriptors have nothing, the grey levels seen
+// from above still place one on the other.
+struct GroundPair {
+  std::shared_ptr<const Submap> a, b;
+  FourDofTransform T_a_b;
+};
+
+// A sees world x <= a_x_max, B x >= b_x_min.
+GroundPair GroundOnly(unsigned seed, double a_x_max = 2.0, double b_x_min = -2.0) {
+  testing::RockFieldOptions o;
+  o.rocks = 0;
+  o.boxes = 0;
+  o.seed = seed;
+  const std::vector<testing::ScenePoint> scene = testing::RockField(o);
+  testing::SceneSubmapOptions sa, sb;
+  sa.x_max = a_x_max;
+  sa.seed = seed + 1;
+  sb.x_min = b_x_min;
+  sb.seed = seed + 2;
+  sa.viewpoints = {{-4.0, -2.0, 1.5}, {0.0, 2.0, 1.5}};
+  sb.viewpoints = {{0.0, -2.0, 1.5}, {4.0, 2.0, 1.5}};
+  const Eigen::Isometry3d T_world_a = testing::YawPose(0.3, {-1.0, 0.5, 0.1});
+  const Eigen::Isometry3d T_world_b = testing::YawPose(1.4, {1.2, -0.7, 0.3});
+  return {testing::SceneSubmap(scene, T_world_a, sa), testing::SceneSubmap(scene, T_world_b, sb),
+          FourDofTransform::FromIsometry(T_world_a.inverse() * T_world_b, 1e-9).value()};
+}
+
+TEST(SubmapMatcherSceneTest, GroundWithoutObstaclesMatchesByTheGreyLevelSearchAlone) {
+  const GroundPair pair = GroundOnly(7);
+  const SubmapFeatureExtractor extractor;
+  const SubmapFeatures fa = extractor.Extract(*pair.a), fb = extractor.Extract(*pair.b);
+  ASSERT_FALSE(fa.suitable());
+  EXPECT_EQ(fa.suitability.reason, SuitabilityReason::kTooFewObstaclePoints);
+  ASSERT_TRUE(fa.searchable && fb.searchable) << fa.ground_area << " " << fb.ground_area;
+  EXPECT_GT(fa.ground_area, 20.0);
+  EXPECT_TRUE(fa.obstacle_box_xy.isEmpty());
+  EXPECT_FALSE(fa.match_box_xy().isEmpty());
+
+  const SubmapMatchResult r = SubmapMatcher().Match(fa, fb);
+  Print("ground only", r);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_EQ(r.correspondences, 0u);
+  EXPECT_GT(r.searched, 0u);
+  EXPECT_NE(r.reason.find("grey-level search"), std::string::npos) << r.reason;
+  EXPECT_LT((r.T_a_b.translation() - pair.T_a_b.translation()).norm(), 0.05);
+  EXPECT_LT(YawError(r.T_a_b, pair.T_a_b), 0.5 * kDegree);
+
+  // The search is the only way: off, the pair is unsuitable, and says why.
+  SubmapMatcherOptions off;
+  off.grey_search.enabled = false;
+  const SubmapMatchResult without = SubmapMatcher(off).Match(fa, fb);
+  EXPECT_EQ(without.status, MatchStatus::kUnsuitable);
+  EXPECT_NE(without.reason.find("the grey-level search is off"), std::string::npos) << without.reason;
+
+  // Disjoint parts of the ground: nothing.
+  const GroundPair apart = GroundOnly(7, -1.0, 1.0);
+  const SubmapMatchResult wrong =
+      SubmapMatcher().Match(extractor.Extract(*apart.a), extractor.Extract(*apart.b));
+  Print("disjoint ground", wrong);
+  EXPECT_EQ(wrong.status, MatchStatus::kNoMatch) << wrong.reason;
 }
 
 }  // namespace
