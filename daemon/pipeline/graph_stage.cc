@@ -80,6 +80,13 @@ bool GraphStage::Add(const SlamFactor& f) {
     return false;
   }
   ++report_.factors;
+  if (f.kind == FactorKind::kLandmark) {
+    ++outside_ties_[RobotOfVariable(f.a)];
+  } else if ((f.kind == FactorKind::kMatch || f.kind == FactorKind::kDetection) &&
+             RobotOfVariable(f.a) != RobotOfVariable(f.b)) {
+    ++outside_ties_[RobotOfVariable(f.a)];
+    ++outside_ties_[RobotOfVariable(f.b)];
+  }
   return true;
 }
 

@@ -179,6 +179,12 @@ class GraphStage {
     return trajectories_.Own().empty() ? Timestamp() : trajectories_.Own().back().time;
   }
   uint64_t submap_origins() const { return report_.submap_origins; }
+  // Factors that tie `robot` (graph letter) to the others: matches and sightings between it and
+  // a teammate, its observations of the lander.
+  uint64_t OutsideTies(char robot) const {
+    const auto it = outside_ties_.find(robot);
+    return it == outside_ties_.end() ? 0 : it->second;
+  }
   uint64_t factors_added() const { return report_.factors; }
   // Whether the last estimate taken became graph pose `*index` (a factor v).
   bool last_estimate_is_pose(uint64_t* index) const {
@@ -259,6 +265,7 @@ class GraphStage {
   std::map<uint64_t, Eigen::Matrix3d> origin_covariance_;  // of the live view, as last computed
   LatencyHistogram update_time_;
   GraphStageReport report_;
+  std::map<char, uint64_t> outside_ties_;
 };
 
 }  // namespace cairn

@@ -371,6 +371,8 @@ TEST(GraphStageTest, ADetectionTiesATeammatesFloatingSubgraphToOurs) {
   EXPECT_EQ(g.report().detections_pending, 0u);
   EXPECT_EQ(g.report().detections, 1u);
   ASSERT_TRUE(g.Connected('b'));
+  EXPECT_EQ(g.OutsideTies('a'), 1u);
+  EXPECT_EQ(g.OutsideTies('b'), 1u);
   g.Finish();
   const Trajectory tb = g.GlobalTrajectory('b');
   ASSERT_EQ(tb.poses.size(), 100u);
@@ -505,6 +507,8 @@ TEST(GraphStageTest, TwoRobotsSeeingTheLanderAreTiedThroughIt) {
   EXPECT_TRUE(g.Connected('b'));
   EXPECT_EQ(drawn(g.Scene(false), 'b'), 5u + 1u);  // its origins and its trajectory
   EXPECT_EQ(g.report().landmark_observations, 2u);
+  EXPECT_EQ(g.OutsideTies('a'), 1u);  // each its sighting of the lander
+  EXPECT_EQ(g.OutsideTies('b'), 1u);
   g.Finish();
   const Trajectory tb = g.GlobalTrajectory('b');
   ASSERT_EQ(tb.poses.size(), 100u);

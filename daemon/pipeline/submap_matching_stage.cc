@@ -170,6 +170,7 @@ void SubmapMatchingStage::RefreshEstimates(GraphStage& graph) {
     p.component = o.connected ? 0 : 1 + static_cast<unsigned char>(o.robot);
     p.T_world_submap = o.T_global_origin;
     p.covariance = o.covariance;
+    p.robot_ties = graph.OutsideTies(o.robot);
     pairing_.Update(p);
   }
   estimates_stale_ = false;

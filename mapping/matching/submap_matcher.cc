@@ -311,12 +311,13 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   }
   r.times.ransac_ms = MillisecondsSince(stage);
   if (search_only) {
-    const SubmapFeatures& unsuitable = a.suitable() ? b : a;
-    rejections.Add("no descriptors", Format("%s unsuitable for descriptors (%s): grey-level search only",
-                                            !a.suitable() && !b.suitable() ? "submaps A and B"
-                                            : a.suitable()                 ? "submap B"
-                                                                           : "submap A",
-                                            unsuitable.suitability.message.c_str()));
+    std::string unsuitable;
+    for (const SubmapFeatures* side : {&a, &b}) {
+      if (side->suitable()) continue;
+      unsuitable += Format("%ssubmap %s (%s)", unsuitable.empty() ? "" : " and ", side == &a ? "A" : "B",
+                           side->suitability.message.c_str());
+    }
+    rejections.Add("no descriptors", unsuitable + " unsuitable for descriptors: grey-level search only");
   } else if (votes.clusters.empty()) {
     rejections.Add("no vote cluster", Format("%zu correspondences, no vote cluster", correspondences.size()));
   }

@@ -90,7 +90,9 @@ PairSkip SubmapPairing::EvaluateOrdered(const PairingSubmap& a, const PairingSub
     area *= std::max(0.0, overlap + options_.sigma_widening * sigma[t]);
   }
   if (!(area > options_.min_overlap_area)) return PairSkip::kNoOverlap;
-  if (sigma.head<3>().mean() < options_.matcher_precision) return PairSkip::kKnownBetter;
+  const bool young_tie = a.key.robot != b.key.robot && std::min(a.robot_ties, b.robot_ties) <
+                                                           static_cast<uint64_t>(options_.min_robot_ties);
+  if (sigma.head<3>().mean() < options_.matcher_precision && !young_tie) return PairSkip::kKnownBetter;
   if (pair != nullptr) {
     pair->a = a.key;
     pair->b = b.key;

@@ -41,6 +41,11 @@ struct SubmapPairingOptions {
   double matcher_precision = 0.0;  // m; eq. 6.3's right-hand side (StereoPrecision); 0: no pair skipped
   double min_relative_sigma = 0.0;  // m; floor of dsigma_t (rad for yaw)
   bool skip_consecutive = true;
+  // Two robots' submaps are not skipped as known better (eq. 6.3) while either robot has fewer
+  // than this many factors tying it to the others (matches, sightings, lander observations): the
+  // graph's confidence then rests on one match, whose error (a few tenths of a degree) would
+  // otherwise fix the robot's place in the team for good. 0: eq. 6.3 alone.
+  int64_t min_robot_ties = 2;
   // Pairs whose origins the graph has not tied together (a teammate not yet connected) are tried
   // too, after every other candidate, without a prior: the only way two robots that never met
   // find each other's places.
@@ -53,6 +58,7 @@ struct SubmapPairingOptions {
     v.Number("matcher_precision", matcher_precision, 0.0, 100.0, "m");
     v.Number("min_relative_sigma", min_relative_sigma, 0.0, 100.0, "m");
     v.Flag("skip_consecutive", skip_consecutive);
+    v.Integer("min_robot_ties", min_robot_ties, 0, 1000, "factors");
     v.Flag("match_unconnected", match_unconnected);
   }
 };
@@ -74,6 +80,7 @@ struct PairingSubmap {
   int component = 0;
   FourDofTransform T_world_submap;
   Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+  uint64_t robot_ties = 0;  // factors tying its robot to the others (SubmapPairingOptions)
 };
 
 struct SubmapPair {

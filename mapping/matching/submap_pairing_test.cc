@@ -146,6 +146,28 @@ TEST(SubmapPairingTest, PairsKnownBetterThanTheStereoErrorAreSkipped) {
   EXPECT_EQ(pairing.Evaluate({"a", 1}, {"a", 7}), PairSkip::kNone);
 }
 
+TEST(SubmapPairingTest, TwoRobotsTiedByFewFactorsAreMatchedAlthoughKnownBetter) {
+  SubmapPairingOptions options;
+  options.matcher_precision = 0.116;
+  SubmapPairing pairing(options);
+  PairingSubmap a = Placed("a", 1, 0.0, 0.0, 0.0, 0.0), a2 = Placed("a", 7, 1.0, 0.0, 0.0, 0.01);
+  PairingSubmap b = Placed("b", 1, 1.0, 0.0, 0.0, 0.01);  // dsigma 0.1 m, below the precision
+  a.robot_ties = a2.robot_ties = 5;
+  b.robot_ties = 1;  // one match alone ties robot b to a
+  for (const PairingSubmap& s : {a, a2, b}) pairing.Update(s);
+  EXPECT_EQ(pairing.Evaluate({"a", 1}, {"b", 1}), PairSkip::kNone);
+  EXPECT_EQ(pairing.Evaluate({"a", 1}, {"a", 7}), PairSkip::kKnownBetter);  // one robot's: eq. 6.3
+  b.robot_ties = 2;
+  pairing.Update(b);
+  EXPECT_EQ(pairing.Evaluate({"a", 1}, {"b", 1}), PairSkip::kKnownBetter);
+  b.robot_ties = 0;
+  pairing.Update(b);
+  options.min_robot_ties = 0;  // eq. 6.3 alone
+  SubmapPairing thesis(options);
+  for (const PairingSubmap& s : {a, a2, b}) thesis.Update(s);
+  EXPECT_EQ(thesis.Evaluate({"a", 1}, {"b", 1}), PairSkip::kKnownBetter);
+}
+
 TEST(SubmapPairingTest, HandsOutEachPairOnceBestScoreFirst) {
   SubmapPairing pairing;
   pairing.Update(Placed("a", 1, 0.0, 0.0, 0.0, 0.0));
