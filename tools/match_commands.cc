@@ -114,7 +114,7 @@ double TrueOverlap(const Submap& a, const Submap& b, const FourDofTransform& T_a
 }
 
 // Which pairs the bench tries, by whether their submaps are suitable for the descriptors.
-enum class SearchOnly { kNone, kWith, kOnly };
+enum class PairSet { kSuitable, kAll, kSearchOnly };
 
 }  // namespace
 
@@ -141,7 +141,7 @@ int RunBenchMatch(const CommandArgs& args) {
   std::vector<double> wire_bits;  // offset, intensity; empty: the submaps as read
   SubmapMatcherOptions matcher_options;
   ShotFrame frame = ShotFrame::kGravity;
-  SearchOnly search_only = SearchOnly::kWith;
+  PairSet pair_set = PairSet::kAll;
   for (size_t i = 0; i < args.args.size(); ++i) {
     const std::string a = args.args[i];
     std::vector<double> v;
@@ -164,9 +164,9 @@ int RunBenchMatch(const CommandArgs& args) {
     } else if (a == "--no-lines") {
       matcher_options.lines.enabled = false;
     } else if (a == "--suitable-only") {
-      search_only = SearchOnly::kNone;
+      pair_set = PairSet::kSuitable;
     } else if (a == "--search-only") {
-      search_only = SearchOnly::kOnly;
+      pair_set = PairSet::kSearchOnly;
     } else if (a == "--dof" && i + 1 < args.args.size() &&
                (args.args[i + 1] == std::string("4") || args.args[i + 1] == std::string("6"))) {
       frame = args.args[++i] == std::string("6") ? ShotFrame::kFull : ShotFrame::kGravity;
@@ -230,8 +230,8 @@ int RunBenchMatch(const CommandArgs& args) {
       const IndexedSubmap& b = submaps[j];
       if (a.robot == b.robot && (a.id + 1 == b.id || b.id + 1 == a.id)) continue;
       if (!a.features.matchable() || !b.features.matchable()) continue;
-      if (search_only == SearchOnly::kNone && (!a.features.suitable() || !b.features.suitable())) continue;
-      if (search_only == SearchOnly::kOnly && a.features.suitable() && b.features.suitable()) continue;
+      if (pair_set == PairSet::kSuitable && (!a.features.suitable() || !b.features.suitable())) continue;
+      if (pair_set == PairSet::kSearchOnly && a.features.suitable() && b.features.suitable()) continue;
       const FourDofTransform truth = a.T_world_submap.inverse() * b.T_world_submap;
       const double overlap = std::max(TrueOverlap(*a.submap, *b.submap, truth),
                                       TrueOverlap(*b.submap, *a.submap, truth.inverse()));

@@ -162,8 +162,8 @@ void SubmapMatchingStage::RefreshEstimates(GraphStage& graph) {
     if (f == features_.end()) continue;
     PairingSubmap p;
     p.key = f->first;
-    p.suitable = f->second->matchable();
-    p.obstacle_box_xy = f->second->match_box_xy();
+    p.matchable = f->second->matchable();
+    p.box_xy = f->second->match_box_xy();
     p.placed = o.has_covariance;
     // Robots not tied to this one each float on their own (two of them may be tied to each other;
     // the pairing then tries a global search where a prior would do, never the reverse).

@@ -1,12 +1,10 @@
 #include "mapping/matching/submap_feature_extractor.h"
 
 #include <chrono>
-#include <cmath>
-#include <cstdint>
-#include <unordered_set>
 
 #include "common/elapsed.h"
 #include "common/heap_bytes.h"
+#include "mapping/voxel_hash_map.h"
 
 namespace cairn {
 namespace {
@@ -16,12 +14,12 @@ constexpr double kSearchCell = 0.2;  // m
 
 // Area of the xy cells of kSearchCell that hold at least one point.
 double GroundArea(const std::vector<Eigen::Vector3d>& cloud) {
-  std::unordered_set<uint64_t> cells;
-  cells.reserve(cloud.size() / 4);
+  VoxelHashMap<uint8_t> cells(cloud.size() / 8);
+  uint64_t key = 0;
   for (const Eigen::Vector3d& p : cloud) {
-    const auto x = static_cast<int64_t>(std::floor(p.x() / kSearchCell));
-    const auto y = static_cast<int64_t>(std::floor(p.y() / kSearchCell));
-    cells.insert(static_cast<uint64_t>(x) << 32 ^ (static_cast<uint64_t>(y) & 0xffffffffu));
+    if (VoxelKey::Of(Eigen::Vector3f(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.0f),
+                     static_cast<float>(1.0 / kSearchCell), &key))
+      cells[key] = 1;
   }
   return static_cast<double>(cells.size()) * kSearchCell * kSearchCell;
 }
@@ -52,23 +50,19 @@ SubmapFeatures SubmapFeatureExtractor::Extract(const Submap& submap) const {
     f.keypoints = KeypointExtractor(options_.keypoints).Extract(submap);
     f.suitability = suitability.Check(submap, f.keypoints.points);
   }
+  // The search turns about gravity: only for the 4-DoF matcher's features.
+  if (!f.suitability.suitable() && f.suitability.reason != SuitabilityReason::kTooFewPoints &&
+      frame_ == ShotFrame::kGravity && options_.min_search_area > 0.0) {
+    f.ground_area = GroundArea(f.cloud);
+    f.searchable = f.ground_area >= options_.min_search_area;
+  }
   f.keypoint_ms = MillisecondsSince(start);
   if (!f.suitability.suitable()) {
-    // The search turns about gravity: only for the 4-DoF matcher's features.
-    if (f.suitability.reason != SuitabilityReason::kTooFewPoints && frame_ == ShotFrame::kGravity &&
-        options_.min_search_area > 0.0) {
-      f.ground_area = GroundArea(f.cloud);
-      f.searchable = f.ground_area >= options_.min_search_area;
+    if (!f.searchable) {
+      // Never aligned, but kept for the whole mission.
+      f.cloud = std::vector<Eigen::Vector3d>();  // frees it (assigning {} would keep the capacity)
+      f.cloud_grey = std::vector<float>();
     }
-    f.keypoint_ms = MillisecondsSince(start);
-    if (f.searchable) {
-      f.cloud.shrink_to_fit();
-      f.cloud_grey.shrink_to_fit();
-      return f;
-    }
-    // Never aligned, but kept for the whole mission.
-    f.cloud = std::vector<Eigen::Vector3d>();  // frees it (assigning {} would keep the capacity)
-    f.cloud_grey = std::vector<float>();
     return f;
   }
 

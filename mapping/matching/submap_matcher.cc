@@ -181,7 +181,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   // A submap the descriptors cannot use may still be matched by the grey-level search alone.
   const bool search_only = !a.suitable() || !b.suitable();
   for (const SubmapFeatures* side : {&a, &b}) {
-    if (side->matchable() && (side->suitable() || options_.grey_search.enabled)) continue;
+    if (side->suitable() || (side->searchable && options_.grey_search.enabled)) continue;
     return finish(MatchStatus::kUnsuitable, std::string(side == &a ? "submap A: " : "submap B: ") +
                                                 side->suitability.message +
                                                 (side->searchable ? "; the grey-level search is off" : ""));

@@ -55,7 +55,7 @@ SubmapPairing::PairKey SubmapPairing::Ordered(const SubmapKey& a, const SubmapKe
 void SubmapPairing::Update(const PairingSubmap& submap) { submaps_[submap.key] = submap; }
 
 PairSkip SubmapPairing::EvaluateOrdered(const PairingSubmap& a, const PairingSubmap& b, SubmapPair* pair) const {
-  if (!a.suitable || !b.suitable) return PairSkip::kUnsuitable;
+  if (!a.matchable || !b.matchable) return PairSkip::kUnsuitable;
   if (owned_ && !owned_(a.key, b.key)) return PairSkip::kTeammate;
   // A match ties graph variables: both submaps' frames must be in the graph.
   if (!a.placed || !b.placed) return PairSkip::kNotPlaced;
@@ -75,15 +75,15 @@ PairSkip SubmapPairing::EvaluateOrdered(const PairingSubmap& a, const PairingSub
   if (options_.skip_consecutive && a.key.robot == b.key.robot &&
       (a.key.id + 1 == b.key.id || b.key.id + 1 == a.key.id))
     return PairSkip::kConsecutive;
-  if (a.obstacle_box_xy.isEmpty() || b.obstacle_box_xy.isEmpty()) return PairSkip::kNoOverlap;
+  if (a.box_xy.isEmpty() || b.box_xy.isEmpty()) return PairSkip::kNoOverlap;
 
   Eigen::Vector4d sigma;
   for (int t = 0; t < 4; ++t) {
     const double d = std::abs(a.covariance(t, t) - b.covariance(t, t));
     sigma[t] = std::max(std::isfinite(d) ? std::sqrt(d) : 0.0, options_.min_relative_sigma);
   }
-  const Eigen::AlignedBox2d box_a = WorldBox(a.obstacle_box_xy, a.T_world_submap);
-  const Eigen::AlignedBox2d box_b = WorldBox(b.obstacle_box_xy, b.T_world_submap);
+  const Eigen::AlignedBox2d box_a = WorldBox(a.box_xy, a.T_world_submap);
+  const Eigen::AlignedBox2d box_b = WorldBox(b.box_xy, b.T_world_submap);
   double area = 1.0;
   for (int t = 0; t < 2; ++t) {
     const double overlap = std::min(box_a.max()[t], box_b.max()[t]) - std::max(box_a.min()[t], box_b.min()[t]);

@@ -1,11 +1,11 @@
 #pragma once
 // Which submaps to match, most promising first (thesis 6.1.1, eqs. 6.1 to 6.4). For each pair of
-// suitable submaps whose origins the graph has placed in one connected component:
+// matchable submaps whose origins the graph has placed in one connected component:
 //   overlap'_t = overlap_t + 2 dsigma_t, t in {x, y}            (6.1; overlap_t is signed, so boxes
 //   overlap'_xy = overlap'_x * overlap'_y                        apart by less than 2 dsigma count)
-// of the xy boxes of their obstacle points in the world; a pair is kept when overlap'_xy exceeds
-// min_overlap_area, it is not two consecutive submaps of one robot, and its relative pose is not
-// already known better than the matcher could measure it (6.3):
+// of the xy boxes of what is matched (SubmapFeatures::match_box_xy) in the world; a pair is kept
+// when overlap'_xy exceeds min_overlap_area, it is not two consecutive submaps of one robot, and
+// its relative pose is not already known better than the matcher could measure it (6.3):
 //   mean(dsigma_x, dsigma_y, dsigma_z) >= matcher_precision   (eq. 6.3's stereo error)
 // and ranked by score = alpha overlap'_xy + sum_t dsigma_t (6.4).
 //
@@ -72,8 +72,8 @@ struct SubmapKey {
 // What the pairing knows of one submap.
 struct PairingSubmap {
   SubmapKey key;
-  bool suitable = false;
-  Eigen::AlignedBox2d obstacle_box_xy;  // submap frame (SubmapFeatures::obstacle_box_xy)
+  bool matchable = false;      // SubmapFeatures::matchable: with descriptors or by the search alone
+  Eigen::AlignedBox2d box_xy;  // submap frame (SubmapFeatures::match_box_xy)
   // The graph's estimate of the origin: placed, its component, pose and marginal covariance of
   // (x, y, z, yaw) in the world.
   bool placed = false;

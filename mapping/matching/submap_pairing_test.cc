@@ -13,8 +13,8 @@ PairingSubmap Placed(const std::string& robot, uint64_t id, double x, double y, 
                      double variance = 0.0) {
   PairingSubmap s;
   s.key = {robot, id};
-  s.suitable = true;
-  s.obstacle_box_xy = Eigen::AlignedBox2d(Eigen::Vector2d(0, 0), Eigen::Vector2d(4, 4));
+  s.matchable = true;
+  s.box_xy = Eigen::AlignedBox2d(Eigen::Vector2d(0, 0), Eigen::Vector2d(4, 4));
   s.placed = true;
   s.T_world_submap = FourDofTransform(x, y, 0.0, yaw);
   s.covariance = Eigen::Matrix4d::Identity() * variance;
@@ -76,7 +76,7 @@ TEST(SubmapPairingTest, SkipsConsecutiveUnsuitableUnplacedAndDisconnected) {
   EXPECT_EQ(pairing.Evaluate({"a", 2}, {"a", 1}), PairSkip::kConsecutive);
   EXPECT_EQ(pairing.Evaluate({"a", 1}, {"b", 2}), PairSkip::kNone);  // another robot's
   PairingSubmap u = Placed("c", 1, 0.0, 0.0);
-  u.suitable = false;
+  u.matchable = false;
   pairing.Update(u);
   EXPECT_EQ(pairing.Evaluate({"a", 1}, {"c", 1}), PairSkip::kUnsuitable);
   PairingSubmap n = Placed("c", 2, 0.0, 0.0);
