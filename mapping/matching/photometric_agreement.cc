@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 namespace cairn {
 
 PhotometricAgreement::PhotometricAgreement(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
@@ -62,6 +64,23 @@ FourDofTransform PhotometricAgreement::Refine(const std::vector<Eigen::Vector3d>
                                               double step_translation, double step_yaw, int max_scores,
                                               PhotometricScore* best) const {
   const auto Value = [](const PhotometricScore& s) { return std::isfinite(s.ncc) ? s.ncc : -2.0; };
+  // Yaw turns B about the centre of the overlap (B's points that fall into A's voxels at the
+  // start), not about B's origin: about the origin a yaw step also slides the overlap by its
+  // distance times the step (0.1 m for 0.01 rad at 10 m), so x, y and yaw are coupled, and the
+  // search along the axes zigzags down the diagonal valley until the scores run out (on a team
+  // mission's submaps, 34 of 136 refinements did).
+  const Eigen::Isometry3d T_start = start.ToIsometry();
+  Eigen::Vector3d overlap_b = Eigen::Vector3d::Zero();  // in B, so that it moves with B
+  size_t overlapping = 0;
+  for (size_t i = 0; i < std::min(cloud.size(), grey.size()); ++i) {
+    uint64_t key = 0;
+    if (!std::isfinite(grey[i]) || !VoxelKey::Of((T_start * cloud[i]).cast<float>(), inverse_voxel_, &key) ||
+        cells_.Find(key) == nullptr)
+      continue;
+    overlap_b += cloud[i];
+    ++overlapping;
+  }
+  if (overlapping > 0) overlap_b /= static_cast<double>(overlapping);
   FourDofTransform at = start;
   PhotometricScore here = Score(cloud, grey, at);
   int scores = 1;
@@ -72,8 +91,10 @@ FourDofTransform PhotometricAgreement::Refine(const std::vector<Eigen::Vector3d>
     static constexpr int kAxes[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     FourDofTransform next = at;
     PhotometricScore next_score = here;
+    const Eigen::Vector2d centre = (at.ToIsometry() * overlap_b).head<2>();
     for (const auto& axis : kAxes) {
-      const Eigen::Vector3d t = at.translation() + Eigen::Vector3d(axis[0] * dt, axis[1] * dt, 0.0);
+      Eigen::Vector3d t = at.translation() + Eigen::Vector3d(axis[0] * dt, axis[1] * dt, 0.0);
+      if (axis[2] != 0) t.head<2>() = centre + Eigen::Rotation2Dd(axis[2] * dyaw) * (t.head<2>() - centre);
       const FourDofTransform trial(t, at.yaw() + axis[2] * dyaw);
       const PhotometricScore s = Score(cloud, grey, trial);
       ++scores;

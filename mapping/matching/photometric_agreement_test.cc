@@ -1,9 +1,11 @@
 #include "mapping/matching/photometric_agreement.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 namespace cairn {
@@ -62,6 +64,33 @@ TEST(PhotometricAgreementTest, RefinementMovesXYAndYawToTheBestAgreement) {
   // The budget of scores holds: with 7 only one round of 6 neighbours is tried.
   check.Refine(b.points, b.grey, off, 0.04, 0.01, 7, &after);
   EXPECT_GE(after.ncc, before.ncc);
+}
+
+// Ground 12 m from B's origin, left 1.7 deg off about the ground itself (as an ICP leaves a
+// match: the overlap in place, the turn to chance). About B's origin that is also 0.37 m of
+// translation; the search turns B about its centroid, so it needs no long zigzag of x, y and yaw
+// steps and converges within the budget the matcher used to give it.
+TEST(PhotometricAgreementTest, RefinementFarFromTheOriginTurnsAboutTheGround) {
+  Ground a = MakeGround(4);
+  for (Eigen::Vector3d& p : a.points) p += Eigen::Vector3d(12.0, 3.0, 0.0);
+  const FourDofTransform truth(4.0, -2.0, 0.05, 0.4);
+  const Ground b = InFrameB(a, truth);
+  const PhotometricAgreement check(a.points, a.grey, 0.05);
+  const Eigen::Vector2d centre(14.0, 5.0);  // the ground's middle, in A
+  const double turn = 0.03;
+  const Eigen::Vector2d t = centre + Eigen::Rotation2Dd(turn) * (truth.translation().head<2>() - centre);
+  const FourDofTransform off(Eigen::Vector3d(t.x() + 0.05, t.y() - 0.04, truth.translation().z()),
+                             truth.yaw() + turn);
+  ASSERT_GT((off.translation() - truth.translation()).head<2>().norm(), 0.35);
+  PhotometricScore before = check.Score(b.points, b.grey, off), after;
+  const FourDofTransform refined = check.Refine(b.points, b.grey, off, 0.04, 0.01, 80, &after);
+  EXPECT_GT(after.ncc, before.ncc + 0.2) << before.ncc;
+  // Within the score's resolution (half a voxel) at every point of the ground.
+  double worst = 0.0;
+  for (const Eigen::Vector3d& p : b.points) {
+    worst = std::max(worst, (refined.ToIsometry() * p - truth.ToIsometry() * p).norm());
+  }
+  EXPECT_LT(worst, 0.03);
 }
 
 TEST(PhotometricAgreementTest, GreyLevelsAgreeAtTheTrueAlignmentOnly) {

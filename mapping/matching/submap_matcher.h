@@ -83,11 +83,12 @@ struct SubmapMatcherOptions {
   double min_match_ncc = 0.9;
   int64_t min_photometric_pairs = 500;
   // After the ICP (4-DoF), x, y and yaw move to where the grey levels correlate best
-  // (PhotometricAgreement::Refine), from these steps, with at most this many scores.
+  // (PhotometricAgreement::Refine), from these steps, with at most this many scores (enough to
+  // travel max_refinement_translation and still halve the steps).
   bool grey_refinement = true;
   double grey_refinement_step = 0.04;      // m
   double grey_refinement_step_yaw = 0.01;  // rad
-  int64_t grey_refinement_max_scores = 80;
+  int64_t grey_refinement_max_scores = 200;
   // Added (as variances) to the ICP's covariance, which treats every residual as independent: the
   // errors the clouds' points share (each a centroid in a 0.05 m voxel, about 0.014 m RMS, and the
   // stereo calibration) do not average out over thousands of pairs.
