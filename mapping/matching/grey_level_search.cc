@@ -127,6 +127,19 @@ struct SearchPeak {
 
 }  // namespace
 
+Eigen::Vector2d GreyLevelSearch::SearchSlack(const std::vector<Eigen::Vector3d>& cloud_b) const {
+  const double half_step = std::numbers::pi / std::ceil(2.0 * std::numbers::pi / options_.yaw_step);
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  size_t n = 0;
+  for (const Eigen::Vector3d& p : cloud_b) {
+    if (!p.allFinite()) continue;
+    centroid += p.head<2>();
+    ++n;
+  }
+  const double lever = n > 0 ? centroid.norm() / static_cast<double>(n) : 0.0;
+  return {0.5 * std::numbers::sqrt2 * options_.cell + lever * half_step, half_step};
+}
+
 Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen::Vector3d>& cloud_a,
                                                         const std::vector<float>& grey_a,
                                                         const std::vector<Eigen::Vector3d>& cloud_b,
@@ -183,8 +196,12 @@ Expected<GreyLevelSearchResult> GreyLevelSearch::Search(const std::vector<Eigen:
   const int suppress = std::max(1, static_cast<int>(std::ceil(o.separation_translation / o.cell)));
   std::vector<SearchPeak> peaks;
   cv::Mat score(rows, cols, CV_32F);
+  // A window's yaws are stepped from its centre, so that a narrow one (a relative estimate the
+  // graph knows well) searches that yaw itself rather than the grid's nearest, up to half a step off.
+  const bool windowed = yaw_window.y() < std::numbers::pi;
   for (int k = 0; k < yaws; ++k) {
-    const double yaw = -std::numbers::pi + step * k;
+    const double yaw =
+        windowed ? WrapAngle(yaw_window.x() + step * (k - yaws / 2)) : -std::numbers::pi + step * k;
     if (std::abs(WrapAngle(yaw - yaw_window.x())) > yaw_window.y() + 0.5 * step) continue;
     ++out.yaws;
     const Eigen::Vector2d turned_centre = Eigen::Rotation2Dd(yaw) * centre_b;

@@ -70,12 +70,20 @@ class GreyLevelSearch {
   // and grey decides; non-finite values are skipped). Refused only for options out of range or
   // rasters beyond a sane size; no candidate is not an error.
   // `yaw_window` (centre, half width in rad) limits the yaws searched, e.g. to the gate around the
-  // graph's relative estimate; half width >= pi searches all.
+  // graph's relative estimate: its centre and steps from it, to half a step beyond the half width.
+  // Half width >= pi searches all. A candidate's xy is the peak's cell, so it may be off by half a
+  // cell, and by the yaw's error times its distance from B's origin (SearchSlack).
   Expected<GreyLevelSearchResult> Search(const std::vector<Eigen::Vector3d>& cloud_a,
                                          const std::vector<float>& grey_a,
                                          const std::vector<Eigen::Vector3d>& cloud_b,
                                          const std::vector<float>& grey_b,
                                          Eigen::Vector2d yaw_window = {0.0, 4.0}) const;
+
+  // How far (m, rad) a candidate may lie from the true alignment by the search's steps alone,
+  // for B's cloud: half a cell's diagonal plus half a yaw step times the distance of B's centroid
+  // from its origin, and half a yaw step. A gate applied to a candidate before its refinement
+  // widens by this much.
+  Eigen::Vector2d SearchSlack(const std::vector<Eigen::Vector3d>& cloud_b) const;
 
  private:
   GreyLevelSearchOptions options_;

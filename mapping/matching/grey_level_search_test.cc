@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -99,6 +100,38 @@ TEST(GreyLevelSearchTest, AYawWindowSearchesOnlyItsYaws) {
   const Expected<GreyLevelSearchResult> elsewhere = GreyLevelSearch().Search(a, ga, b, gb, {-1.0, 0.1});
   ASSERT_TRUE(elsewhere.ok());
   EXPECT_TRUE(elsewhere->candidates.empty());
+}
+
+// A window narrower than a step searches its centre's yaw itself, not the nearest of the full
+// search's steps (up to 1.5 deg off), so a gate that narrow can admit the candidate.
+TEST(GreyLevelSearchTest, ANarrowWindowSearchesItsCentre) {
+  const AlbedoGround ground(7);
+  std::vector<Eigen::Vector3d> a, b;
+  std::vector<float> ga, gb;
+  const double yaw = 1.0 + 0.5 * GreyLevelSearchOptions().yaw_step;
+  ground.Sample({0.0, 0.0}, 4.0, FourDofTransform(), &a, &ga);
+  ground.Sample({1.0, 0.0}, 4.0, FourDofTransform(0.0, 0.0, 0.0, yaw), &b, &gb);
+  const Expected<GreyLevelSearchResult> r = GreyLevelSearch().Search(a, ga, b, gb, {yaw, 0.0});
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->yaws, 1);
+  ASSERT_FALSE(r->candidates.empty());
+  EXPECT_NEAR(r->candidates.front().T_a_b.yaw(), yaw, 1e-9);
+}
+
+// What a candidate may be off by the steps alone: half a cell's diagonal, and half a yaw step,
+// which at B's centroid 10 m from its origin is another 0.26 m.
+TEST(GreyLevelSearchTest, TheSlackGrowsWithTheDistanceOfBsCloud) {
+  const GreyLevelSearch search;
+  const double half_step =
+      std::numbers::pi / std::ceil(2.0 * std::numbers::pi / GreyLevelSearchOptions().yaw_step);
+  const std::vector<Eigen::Vector3d> near{{-1.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+  const std::vector<Eigen::Vector3d> far{
+      {5.0, 8.0, 0.0}, {7.0, 8.0, 3.0}, {std::numeric_limits<double>::quiet_NaN(), 0.0, 0.0}};
+  const double cell = 0.5 * std::numbers::sqrt2 * GreyLevelSearchOptions().cell;
+  EXPECT_NEAR(search.SearchSlack(near).x(), cell, 1e-12);
+  EXPECT_NEAR(search.SearchSlack(near).y(), half_step, 1e-12);
+  EXPECT_NEAR(search.SearchSlack(far).x(), cell + 10.0 * half_step, 1e-9);
+  EXPECT_NEAR(search.SearchSlack({}).x(), cell, 1e-12);
 }
 
 TEST(GreyLevelSearchTest, EmptyNonFiniteAndHugeInputsAreHandled) {

@@ -149,14 +149,14 @@ Status SubmapMatcherOptions::Validate() const {
 }
 
 bool SubmapMatcher::WithinGate(const FourDofTransform& T_a_b, const RelativePoseEstimate& prior,
-                               std::string* why) const {
+                               std::string* why, const Eigen::Vector2d& slack) const {
   static constexpr const char* kAxis[4] = {"x", "y", "z", "yaw"};
   const Eigen::Vector4d d = T_a_b.ToVector() - prior.T_a_b.ToVector();
   for (int i = 0; i < 4; ++i) {
     const double off = i == 3 ? std::abs(WrapAngle(d[i])) : std::abs(d[i]);
     const double sigma = std::sqrt(std::max(prior.covariance(i, i), 0.0));
     const double floor = i == 3 ? options_.gate_floor_yaw : options_.gate_floor_translation;
-    const double bound = std::max(options_.gate_sigmas * sigma, floor);
+    const double bound = std::max(options_.gate_sigmas * sigma, floor) + (i == 3 ? slack.y() : slack.x());
     if (!(off <= bound)) {
       if (why != nullptr)
         *why = Format("%s off the relative estimate by %.3f%s, gate %.3f", kAxis[i], off, i == 3 ? " rad" : " m",
@@ -401,12 +401,12 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
   // A hypothesis from another source than the descriptors: the gate, then the grey levels, which
   // must agree (undecided is refused too: no keypoints vouch for it), then the refinement.
   const auto Alternative = [&](const FourDofTransform& T_a_b, const char* kind, const std::string& source,
-                               double min_match_ncc) {
+                               double min_match_ncc, const Eigen::Vector2d& gate_slack) {
     Hypothesis h;
     h.T_a_b = T_a_b;
     h.T_full = h.T_a_b.ToIsometry();
     std::string why;
-    if (prior.has_value() && !WithinGate(h.T_a_b, *prior, &why)) {
+    if (prior.has_value() && !WithinGate(h.T_a_b, *prior, &why, gate_slack)) {
       rejections.Add(Format("%ss outside the gate", kind), Format("%s ", kind) + why);
       return false;
     }
@@ -431,7 +431,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       ++r.plane_hypotheses;
       if (Alternative(candidate.T_a_b, "plane pairing",
                       Format("planar faces paired (smallest %.1f m^2)", candidate.area),
-                      options_.min_match_ncc))
+                      options_.min_match_ncc, Eigen::Vector2d::Zero()))
         return finish(MatchStatus::kMatched, r.reason);
     }
   }
@@ -446,7 +446,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       if (Alternative(candidate.T_a_b, "edge pairing",
                       Format("straight edges paired (%d agree, shortest %.1f m)", candidate.edges_agreeing,
                              candidate.length),
-                      options_.min_match_ncc))
+                      options_.min_match_ncc, Eigen::Vector2d::Zero()))
         return finish(MatchStatus::kMatched, r.reason);
     }
   }
@@ -461,9 +461,12 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
       const double sigma = std::sqrt(std::max(prior->covariance(3, 3), 0.0));
       yaw_window = {prior->T_a_b.yaw(), std::max(options_.gate_sigmas * sigma, options_.gate_floor_yaw)};
     }
+    const GreyLevelSearch search(options_.grey_search);
     Expected<GreyLevelSearchResult> found =
-        GreyLevelSearch(options_.grey_search)
-            .Search(a.cloud, a.cloud_grey, b.cloud, b.cloud_grey, yaw_window);
+        search.Search(a.cloud, a.cloud_grey, b.cloud, b.cloud_grey, yaw_window);
+    // The gate before the refinement allows for the search's cells and yaw steps; the refined
+    // match meets the gate itself.
+    const Eigen::Vector2d slack = search.SearchSlack(b.cloud);
     r.times.search_ms = MillisecondsSince(stage);
     if (!found.ok()) {
       rejections.Add("grey-level search refused", found.status().message());
@@ -475,7 +478,7 @@ SubmapMatchResult SubmapMatcher::Match(const SubmapFeatures& a, const SubmapFeat
         if (Alternative(candidate.T_a_b, "searched candidate",
                         Format("grey-level search, raster correlation %.3f over %lld cells",
                                candidate.correlation, static_cast<long long>(candidate.overlap_cells)),
-                        std::max(options_.min_match_ncc, options_.grey_search.min_match_ncc)))
+                        std::max(options_.min_match_ncc, options_.grey_search.min_match_ncc), slack))
           return finish(MatchStatus::kMatched, r.reason);
       }
     }

@@ -185,8 +185,10 @@ class SubmapMatcher {
   SubmapMatchResult Match(const SubmapFeatures& a, const SubmapFeatures& b,
                           const std::optional<RelativePoseEstimate>& prior = std::nullopt) const;
 
-  // Whether `T_a_b` lies within the gate around `prior`; otherwise `why` says which axis is off.
-  bool WithinGate(const FourDofTransform& T_a_b, const RelativePoseEstimate& prior, std::string* why) const;
+  // Whether `T_a_b` lies within the gate around `prior`, each bound widened by `slack` (m, rad: what
+  // a not yet refined candidate may be off by itself); otherwise `why` says which axis is off.
+  bool WithinGate(const FourDofTransform& T_a_b, const RelativePoseEstimate& prior, std::string* why,
+                  const Eigen::Vector2d& slack = Eigen::Vector2d::Zero()) const;
 
  private:
   SubmapMatcherOptions options_;

@@ -359,7 +359,7 @@ struct GroundPair {
 };
 
 // A sees world x <= a_x_max, B x >= b_x_min.
-GroundPair GroundOnly(unsigned seed, double a_x_max = 2.0, double b_x_min = -2.0) {
+GroundPair GroundOnly(unsigned seed, double a_x_max = 2.0, double b_x_min = -2.0, double yaw_b = 1.4) {
   testing::RockFieldOptions o;
   o.rocks = 0;
   o.boxes = 0;
@@ -373,7 +373,7 @@ GroundPair GroundOnly(unsigned seed, double a_x_max = 2.0, double b_x_min = -2.0
   sa.viewpoints = {{-4.0, -2.0, 1.5}, {0.0, 2.0, 1.5}};
   sb.viewpoints = {{0.0, -2.0, 1.5}, {4.0, 2.0, 1.5}};
   const Eigen::Isometry3d T_world_a = testing::YawPose(0.3, {-1.0, 0.5, 0.1});
-  const Eigen::Isometry3d T_world_b = testing::YawPose(1.4, {1.2, -0.7, 0.3});
+  const Eigen::Isometry3d T_world_b = testing::YawPose(yaw_b, {1.2, -0.7, 0.3});
   return {testing::SceneSubmap(scene, T_world_a, sa), testing::SceneSubmap(scene, T_world_b, sb),
           FourDofTransform::FromIsometry(T_world_a.inverse() * T_world_b, 1e-9).value()};
 }
@@ -411,6 +411,30 @@ TEST(SubmapMatcherSceneTest, GroundWithoutObstaclesMatchesByTheGreyLevelSearchAl
       SubmapMatcher().Match(extractor.Extract(*apart.a), extractor.Extract(*apart.b));
   Print("disjoint ground", wrong);
   EXPECT_EQ(wrong.status, MatchStatus::kNoMatch) << wrong.reason;
+}
+
+// With a relative estimate the graph knows well, the gate is narrower than the search's steps:
+// B's true yaw here lies half a step (1.5 deg) between two yaws of the full search's grid, and
+// the peak's cell may be 0.1 m off, where the gate is 0.05 m and 0.01 rad wide. The search then
+// steps from the estimate's yaw, the candidate is gated allowing for the steps, and the refined
+// match meets the gate itself.
+TEST(SubmapMatcherSceneTest, SearchedCandidatesAreGatedAllowingForTheSearchsSteps) {
+  const double grid =
+      2.0 * std::numbers::pi / std::ceil(2.0 * std::numbers::pi / GreyLevelSearchOptions().yaw_step);
+  const GroundPair pair = GroundOnly(
+      7, 2.0, -2.0, 0.3 - std::numbers::pi + (std::round((1.1 + std::numbers::pi) / grid) + 0.5) * grid);
+  const SubmapFeatureExtractor extractor;
+  const SubmapFeatures fa = extractor.Extract(*pair.a), fb = extractor.Extract(*pair.b);
+  ASSERT_TRUE(fa.searchable && fb.searchable);
+  RelativePoseEstimate prior;
+  prior.T_a_b = pair.T_a_b;
+  prior.covariance = Eigen::Vector4d(1e-4, 1e-4, 1e-4, 1e-5).asDiagonal();
+  const SubmapMatchResult r = SubmapMatcher().Match(fa, fb, prior);
+  Print("ground only, gated", r);
+  ASSERT_TRUE(r.matched()) << r.reason;
+  EXPECT_NE(r.reason.find("grey-level search"), std::string::npos) << r.reason;
+  EXPECT_LT((r.T_a_b.translation() - pair.T_a_b.translation()).norm(), 0.05);
+  EXPECT_LT(YawError(r.T_a_b, pair.T_a_b), 0.5 * kDegree);
 }
 
 }  // namespace
