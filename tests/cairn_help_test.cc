@@ -15,12 +15,36 @@ namespace {
 std::string Cairn() { return testing::BinaryDir() + "/tools/cairn"; }
 
 // Every command `cairn help` lists but `config doc`, which takes no arguments.
-const std::vector<std::string> kCommands = {
-    "config check", "summary",      "mcap info",   "keys generate", "trajectory convert", "stereo",
-    "stereo-eval",  "bench stereo", "bench fpga",  "bench filter",  "bench rt",           "graph solve",
-    "graph replay", "graph inject", "bench graph", "sim",           "bench sim",          "map",
-    "bench map",    "match",        "bench match", "detect",        "detect build-lut",   "detect check-lut",
-    "bench detect", "eval",         "bench vo",    "bench lines",   "bench landmarks"};
+const std::vector<std::string> kCommands = {"config check",
+                                            "summary",
+                                            "mcap info",
+                                            "keys generate",
+                                            "trajectory convert",
+                                            "stereo",
+                                            "stereo-eval",
+                                            "bench stereo",
+                                            "bench fpga",
+                                            "bench filter",
+                                            "bench rt",
+                                            "graph solve",
+                                            "graph replay",
+                                            "graph inject",
+                                            "graph switch-nees",
+                                            "bench graph",
+                                            "sim",
+                                            "bench sim",
+                                            "map",
+                                            "bench map",
+                                            "match",
+                                            "bench match",
+                                            "detect",
+                                            "detect build-lut",
+                                            "detect check-lut",
+                                            "bench detect",
+                                            "eval",
+                                            "bench vo",
+                                            "bench lines",
+                                            "bench landmarks"};
 
 std::vector<std::string> Words(const std::string& command) {
   std::vector<std::string> out{Cairn()};
@@ -34,7 +58,8 @@ TEST(CairnHelpTest, EveryCommandListedIsCovered) {
   const auto r = testing::RunProcess({Cairn(), "help"});
   ASSERT_EQ(r.exit_code, 0) << r.output;
   size_t listed = 0;
-  for (size_t at = r.output.find("\n  "); at != std::string::npos; at = r.output.find("\n  ", at + 1)) ++listed;
+  for (size_t at = r.output.find("\n  "); at != std::string::npos; at = r.output.find("\n  ", at + 1))
+    ++listed;
   EXPECT_EQ(listed, kCommands.size() + 1) << r.output;  // and `config doc`
   for (const std::string& c : kCommands) EXPECT_NE(r.output.find("\n  " + c + " "), std::string::npos) << c;
 }

@@ -63,6 +63,8 @@ constexpr auto kCommands = std::to_array<Command>({
     {"graph replay", "feed a g2o graph vertex by vertex into the online SLAM graph, time each update",
      RunGraphReplay},
     {"graph inject", "add random false loop closures to a g2o graph (robustness tests)", RunGraphInject},
+    {"graph switch-nees", "a run's frame-switch factors against the simulator's true origins (NEES)",
+     RunGraphSwitchNees},
     {"bench graph", "online SLAM graph on thesis-sized multi-robot graphs: update and covariance times",
      RunBenchGraph},
     {"sim", "simulate a multi-robot mission into EuRoC/ASL folders and CAN logs", RunSim},

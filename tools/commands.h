@@ -39,6 +39,7 @@ int RunBenchFilter(const CommandArgs& args);
 int RunGraphSolve(const CommandArgs& args);
 int RunGraphReplay(const CommandArgs& args);
 int RunGraphInject(const CommandArgs& args);
+int RunGraphSwitchNees(const CommandArgs& args);
 int RunBenchGraph(const CommandArgs& args);
 int RunSim(const CommandArgs& args);
 int RunBenchSim(const CommandArgs& args);
