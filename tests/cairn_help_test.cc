@@ -43,6 +43,7 @@ const std::vector<std::string> kCommands = {"config check",
                                             "bench detect",
                                             "eval",
                                             "bench vo",
+                                            "bench vo-scale",
                                             "bench lines",
                                             "bench landmarks"};
 

@@ -92,6 +92,8 @@ constexpr auto kCommands = std::to_array<Command>({
      RunBenchDetect},
     {"eval", "trajectory accuracy vs ground truth (TUM/EuRoC): ATE, RPE, drift as JSON", RunEval},
     {"bench vo", "visual-odometry time per stereo frame on an EuRoC/ASL folder (no SGM)", RunBenchVo},
+    {"bench vo-scale", "where the odometry gains or loses scale, stage by stage, on simulated pairs",
+     RunBenchVoScale},
 });
 
 void PrintHelp() {

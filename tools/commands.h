@@ -40,6 +40,7 @@ int RunGraphSolve(const CommandArgs& args);
 int RunGraphReplay(const CommandArgs& args);
 int RunGraphInject(const CommandArgs& args);
 int RunGraphSwitchNees(const CommandArgs& args);
+int RunBenchVoScale(const CommandArgs& args);
 int RunBenchGraph(const CommandArgs& args);
 int RunSim(const CommandArgs& args);
 int RunBenchSim(const CommandArgs& args);
