@@ -13,8 +13,10 @@
 
 #include "common/json_value.h"
 #include "estimation/graph/g2o_io.h"
+#include "estimation/graph/pairwise_consistency.h"
 #include "tools/commands.h"
 #include "tools/frame_switch_consistency.h"
+#include "tools/sample_median.h"
 #include "tools/submap_truth.h"
 
 namespace cairn::tools {
@@ -102,17 +104,16 @@ int RunGraphSwitchNees(const CommandArgs& args) {
       longer[r].push_back(e.scale - 1.0);
     }
   }
-  constexpr double kChi2Four95 = 9.4877;
-  for (auto& [robot, nees] : by_robot) {
-    std::sort(nees.begin(), nees.end());
+  const double bound = ChiSquareQuantile(0.95, 4);
+  for (const auto& [robot, nees] : by_robot) {
     double sum = 0.0;
     size_t inside = 0;
     for (double n : nees) {
       sum += n;
-      inside += n <= kChi2Four95 ? 1 : 0;
+      inside += n <= bound ? 1 : 0;
     }
     const size_t k = nees.size();
-    const double median = k % 2 == 1 ? nees[k / 2] : 0.5 * (nees[k / 2 - 1] + nees[k / 2]);
+    const double median = Median(nees);
     const std::vector<double>& l = longer[robot];
     const size_t shorter =
         static_cast<size_t>(std::count_if(l.begin(), l.end(), [](double x) { return x < 0.0; }));

@@ -46,7 +46,7 @@ Rig RigOf(const sim::SimRobot& robot) {
   r.camera.f = st.left.intrinsics.fx;
   r.camera.cx = st.left.intrinsics.cx;
   r.camera.cy = st.left.intrinsics.cy;
-  r.camera.baseline = (st.right.T_body_cam.translation() - st.left.T_body_cam.translation()).norm();
+  r.camera.baseline = st.baseline();
   r.T_body_left = st.left.T_body_cam;
   return r;
 }
