@@ -4,13 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <memory>
-#include <numbers>
 #include <string>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
-#include <ceres/ceres.h>
 #include <opencv2/core.hpp>
 
 #include "estimation/vo/keyframe_visual_odometry.h"
@@ -28,8 +26,9 @@ constexpr const char* kVoScaleUsage =
     "  depth and poses and measures, with the odometry's default options:\n"
     "  - stereo: the disparity of each corner's right-image match against the true one;\n"
     "  - tracking: each corner tracked into the pair 0.2 s later, against its true projection;\n"
-    "  - pose: the 3-D alignment of those pairs' points, |t| against the truth, on the measured\n"
-    "    observations and on exact ones, and a two-frame bundle adjustment of the measured ones;\n"
+    "  - pose: |t| and NEES against the truth from those pairs, by the 3-D alignment of their points alone\n"
+    "    (vo.bundle_iterations 0) on the measured and on exact observations, and by the estimator\n"
+    "    as configured (then a two-frame bundle adjustment) on the measured ones;\n"
     "  - chain: the odometry over 40 s at 10 Hz, its path against the truth's.\n"
     "  N pairs (default 30) for the first three.\n";
 
@@ -60,79 +59,6 @@ struct TrueCorner {
 StereoObservation Project(const RectifiedStereoCamera& c, const Eigen::Vector3d& p) {
   const double u = c.f * p.x() / p.z() + c.cx;
   return {u, u - c.f * c.baseline / p.z(), c.f * p.y() / p.z() + c.cy};
-}
-
-// A stereo observation's residual in pixels (rows: the mean of two, so sigma / sqrt 2) of a point
-// X given in the keyframe's left camera; with `moved`, the point is seen from the current camera,
-// T_kf_cur = (q, t).
-struct StereoReprojection {
-  StereoObservation seen;
-  RectifiedStereoCamera camera;
-  double sigma = 0.3;
-
-  template <typename T>
-  void Residual(const Eigen::Matrix<T, 3, 1>& P, T* r) const {
-    const T f(camera.f), cx(camera.cx), cy(camera.cy), b(camera.baseline);
-    r[0] = (f * P[0] / P[2] + cx - T(seen.u_left)) / T(sigma);
-    r[1] = (f * (P[0] - b) / P[2] + cx - T(seen.u_right)) / T(sigma);
-    r[2] = (f * P[1] / P[2] + cy - T(seen.v)) / T(sigma / std::numbers::sqrt2);
-  }
-};
-
-struct KeyframeReprojection : StereoReprojection {
-  template <typename T>
-  bool operator()(const T* X, T* r) const {
-    Residual(Eigen::Matrix<T, 3, 1>(X[0], X[1], X[2]), r);
-    return true;
-  }
-};
-
-struct CurrentReprojection : StereoReprojection {
-  template <typename T>
-  bool operator()(const T* q, const T* t, const T* X, T* r) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> R(q);
-    Residual(
-        Eigen::Matrix<T, 3, 1>(R.conjugate() * Eigen::Matrix<T, 3, 1>(X[0] - t[0], X[1] - t[1], X[2] - t[2])),
-        r);
-    return true;
-  }
-};
-
-// The fix the pose stage points to, measured on the same observations: the two frames' stereo
-// observations of the estimator's inliers, the points as variables, the pose from the estimator's.
-// Returns |t| of T_kf_cur.
-double TwoFrameBundleLength(const RectifiedStereoCamera& camera, double sigma,
-                            const std::vector<StereoPoint>& kf, const std::vector<StereoPoint>& cur,
-                            const std::vector<uint8_t>& inliers, const Eigen::Isometry3d& T_kf_cur) {
-  Eigen::Quaterniond q(T_kf_cur.linear());
-  Eigen::Vector3d t = T_kf_cur.translation();
-  std::vector<Eigen::Vector3d> points;
-  for (const StereoPoint& p : kf) points.push_back(p.p);
-  ceres::Problem problem;
-  for (size_t i = 0; i < kf.size() && i < inliers.size(); ++i) {
-    if (!inliers[i]) continue;
-    auto* a = new KeyframeReprojection;
-    a->seen = Project(camera, kf[i].p);  // triangulation inverted: the observation itself
-    a->camera = camera;
-    a->sigma = sigma;
-    auto* b = new CurrentReprojection;
-    b->seen = Project(camera, cur[i].p);
-    b->camera = camera;
-    b->sigma = sigma;
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<KeyframeReprojection, 3, 3>(a), nullptr,
-                             points[i].data());
-    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CurrentReprojection, 3, 4, 3, 3>(b), nullptr,
-                             q.coeffs().data(), t.data(), points[i].data());
-  }
-  if (problem.NumResidualBlocks() == 0) return T_kf_cur.translation().norm();
-  problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold);
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_SCHUR;
-  options.max_num_iterations = 20;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  return t.norm();
 }
 
 }  // namespace
@@ -175,7 +101,9 @@ int RunBenchVoScale(const CommandArgs& args) {
   const RectifiedStereoCamera& cam = rig.camera;
   const VoOptions options;
   StereoFeatureTracker tracker(options, cam);
-  StereoPoseEstimator estimator(options);
+  VoOptions alignment_only = options;
+  alignment_only.bundle_iterations = 0;
+  StereoPoseEstimator aligner(alignment_only, cam), estimator(options, cam);
   const auto Wrap = [&](std::vector<uint8_t>& pixels) {
     return cv::Mat(cam.height, cam.width, CV_8UC1, pixels.data());
   };
@@ -184,6 +112,8 @@ int RunBenchVoScale(const CommandArgs& args) {
   };
 
   double disparity_error = 0.0, along_flow = 0.0, flow = 0.0, measured = 0.0, exact = 0.0, bundle = 0.0;
+  double track_sq = 0.0, nees_aligned = 0.0, nees_bundle = 0.0;
+  int64_t tracked_all = 0;
   int64_t matches = 0, tracks = 0, estimates = 0;
   for (int64_t k = 0; k < pairs; ++k) {
     const double t0 = 2.0 + 40.0 * static_cast<double>(k) / static_cast<double>(pairs), t1 = t0 + 0.2;
@@ -224,11 +154,14 @@ int RunBenchVoScale(const CommandArgs& args) {
     std::vector<uint8_t> found;
     tracker.Track(p0, from, predicted, predicted_disparity, p1, &tracked, &found);
     std::vector<StereoPoint> kf, cur, kf_exact, cur_exact;
+    std::vector<StereoObservation> kf_seen, cur_seen, kf_seen_exact, cur_seen_exact;
     for (size_t i = 0; i < corners.size(); ++i) {
       if (!found[i]) continue;
       const Eigen::Vector2d f(truth[i].u_left - from[i].x, truth[i].v - from[i].y);
       const Eigen::Vector2d e(tracked[i].u_left - truth[i].u_left, tracked[i].v - truth[i].v);
       if (e.norm() > 2.0) continue;  // lost: not a bias
+      track_sq += e.squaredNorm();
+      ++tracked_all;
       if (f.norm() > 1.0) {
         along_flow += e.dot(f) / f.norm();
         flow += f.norm();
@@ -247,17 +180,31 @@ int RunBenchVoScale(const CommandArgs& args) {
       cur.push_back(b);
       kf_exact.push_back(a_exact);
       cur_exact.push_back(b_exact);
+      kf_seen.push_back(corners[i].observed);
+      cur_seen.push_back(tracked[i]);
+      kf_seen_exact.push_back(exact_0);
+      cur_seen_exact.push_back(truth[i]);
     }
-    const double true_length = (T_world_left(t0).inverse() * T_world_left(t1)).translation().norm();
-    const PoseEstimate m = estimator.Estimate(kf, cur, static_cast<uint64_t>(k));
-    const std::vector<uint8_t> measured_mask = estimator.inlier_mask();
-    const PoseEstimate x = estimator.Estimate(kf_exact, cur_exact, static_cast<uint64_t>(k));
-    if (m.status == VoStatus::kOk && x.status == VoStatus::kOk && true_length > 0.05) {
+    const Eigen::Isometry3d T_kf_cur_true = T_world_left(t0).inverse() * T_world_left(t1);
+    const double true_length = T_kf_cur_true.translation().norm();
+    const auto Nees = [&](const PoseEstimate& e) {
+      Vector6d d;
+      d.head<3>() = e.T_kf_cur.translation() - T_kf_cur_true.translation();
+      const Eigen::AngleAxisd r(T_kf_cur_true.linear().transpose() * e.T_kf_cur.linear());
+      d.tail<3>() = r.angle() * r.axis();
+      return d.dot(e.covariance.ldlt().solve(d));
+    };
+    const auto ransac_seed = static_cast<uint64_t>(k);
+    const PoseEstimate m = aligner.Estimate(kf_seen, cur_seen, kf, cur, ransac_seed);
+    const PoseEstimate x = aligner.Estimate(kf_seen_exact, cur_seen_exact, kf_exact, cur_exact, ransac_seed);
+    const PoseEstimate b = estimator.Estimate(kf_seen, cur_seen, kf, cur, ransac_seed);
+    if (m.status == VoStatus::kOk && x.status == VoStatus::kOk && b.status == VoStatus::kOk &&
+        true_length > 0.05) {
       measured += m.T_kf_cur.translation().norm() / true_length - 1.0;
-      bundle +=
-          TwoFrameBundleLength(cam, options.pixel_sigma, kf, cur, measured_mask, m.T_kf_cur) / true_length -
-          1.0;
+      bundle += b.T_kf_cur.translation().norm() / true_length - 1.0;
       exact += x.T_kf_cur.translation().norm() / true_length - 1.0;
+      nees_aligned += Nees(m);
+      nees_bundle += Nees(b);
       ++estimates;
     }
   }
@@ -291,12 +238,18 @@ int RunBenchVoScale(const CommandArgs& args) {
   std::printf("  tracking: %lld tracks, %+.4f px along the flow on average (%+.3f %% of the flow)\n",
               static_cast<long long>(tracks), tracks > 0 ? along_flow / static_cast<double>(tracks) : 0.0,
               flow > 0.0 ? 100.0 * along_flow / flow : 0.0);
+  std::printf("  tracking error: %.3f px rms per image axis (the odometry assumes %.3f)\n",
+              tracked_all > 0 ? std::sqrt(track_sq / (2.0 * static_cast<double>(tracked_all))) : 0.0,
+              options.pixel_sigma);
   const double per = estimates > 0 ? 100.0 / static_cast<double>(estimates) : 0.0;
   std::printf(
-      "  pose: %lld pairs, |t| %+.3f %% long on the measured observations, %+.3f %% on exact ones; %+.3f %% "
-      "by "
-      "a two-frame bundle adjustment of the measured ones (points as variables, reprojection error)\n",
+      "  pose: %lld pairs, |t| by the alignment alone %+.3f %% long on the measured observations, %+.3f %% "
+      "on "
+      "exact ones; by the estimator as configured %+.3f %% on the measured ones\n",
       static_cast<long long>(estimates), per * measured, per * exact, per * bundle);
+  std::printf("  pose NEES mean (6 when consistent): alignment alone %.2f, estimator as configured %.2f\n",
+              estimates > 0 ? nees_aligned / static_cast<double>(estimates) : 0.0,
+              estimates > 0 ? nees_bundle / static_cast<double>(estimates) : 0.0);
   std::printf("  chain: path %.3f m against %.3f m, %+.3f %% long\n", est_path, true_path,
               true_path > 0.0 ? 100.0 * (est_path / true_path - 1.0) : 0.0);
   return 0;

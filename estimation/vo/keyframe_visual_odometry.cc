@@ -19,7 +19,7 @@ KeyframeVisualOdometry::KeyframeVisualOdometry(const VoOptions& options, const R
       camera_(camera),
       T_body_cam_(T_body_cam),
       tracker_(options, camera),
-      estimator_(options) {
+      estimator_(options, camera) {
   keyframes_.reserve(static_cast<size_t>(options.keyframes) + 1);
 }
 
@@ -70,12 +70,14 @@ bool KeyframeVisualOdometry::AddKeyframe(Timestamp time, const Eigen::Isometry3d
   kf.T_odom_cam = T_odom_cam;
   kf.left_px.reserve(observations_.size());
   kf.points.reserve(observations_.size());
+  kf.seen.reserve(observations_.size());
   for (const StereoObservation& o : observations_) {
     StereoPoint p;
     if (!TriangulateStereo(camera_, o, options_.pixel_sigma, options_.min_disparity, &p)) continue;
     if (p.cov(2, 2) > options_.max_depth_error * options_.max_depth_error) continue;
     kf.left_px.emplace_back(static_cast<float>(o.u_left), static_cast<float>(o.v));
     kf.points.push_back(p);
+    kf.seen.push_back(o);
   }
   if (static_cast<int64_t>(kf.points.size()) < options_.min_tracks) return false;
   if (static_cast<int64_t>(keyframes_.size()) >= options_.keyframes) {
@@ -123,6 +125,8 @@ PoseEstimate KeyframeVisualOdometry::MatchKeyframe(const Keyframe& kf, const Eig
   tracker_.Track(kf.pair, kf.left_px, predicted_, predicted_disparity_, current_, &observations_, &found_);
   kf_points_.clear();
   cur_points_.clear();
+  kf_seen_.clear();
+  cur_seen_.clear();
   index_.clear();
   for (size_t i = 0; i < n; ++i) {
     if (!found_[i]) continue;
@@ -131,6 +135,8 @@ PoseEstimate KeyframeVisualOdometry::MatchKeyframe(const Keyframe& kf, const Eig
     if (p.cov(2, 2) > options_.max_depth_error * options_.max_depth_error) continue;
     kf_points_.push_back(kf.points[i]);
     cur_points_.push_back(p);
+    kf_seen_.push_back(kf.seen[i]);
+    cur_seen_.push_back(observations_[i]);
     index_.push_back(static_cast<int>(i));
   }
   result->features = static_cast<int>(n);
@@ -140,7 +146,7 @@ PoseEstimate KeyframeVisualOdometry::MatchKeyframe(const Keyframe& kf, const Eig
     e.status = VoStatus::kTooFewTracks;
     return e;
   }
-  e = estimator_.Estimate(kf_points_, cur_points_, seed);
+  e = estimator_.Estimate(kf_seen_, cur_seen_, kf_points_, cur_points_, seed);
   result->inliers = e.inliers;
   if (e.status != VoStatus::kOk) return e;
   // Inliers bunched on one spot constrain the rotation poorly even when the covariance

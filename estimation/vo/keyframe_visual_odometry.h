@@ -7,9 +7,9 @@
 //
 // Per frame: exposure check, pyramids, choice of the keyframe nearest to the predicted pose
 // (the oldest among equals), Lucas-Kanade tracking of its corners, sparse stereo in the current
-// pair, RANSAC + Ceres (estimation/vo/stereo_pose_estimator.h). A frame becomes a keyframe when the
-// tracked share or the motion since its keyframe passes the thresholds; the farthest keyframe
-// then makes room. Failures carry a reason and no estimate.
+// pair, RANSAC, alignment and bundle adjustment (estimation/vo/stereo_pose_estimator.h). A frame
+// becomes a keyframe when the tracked share or the motion since its keyframe passes the
+// thresholds; the farthest keyframe then makes room. Failures carry a reason and no estimate.
 
 #include <array>
 #include <cstdint>
@@ -72,6 +72,7 @@ class KeyframeVisualOdometry {
     StereoPyramids pair;  // pyramids only; the level-0 views are cleared
     std::vector<cv::Point2f> left_px;
     std::vector<StereoPoint> points;  // in the keyframe camera
+    std::vector<StereoObservation> seen;  // the pixels each point was triangulated from
     Eigen::Isometry3d T_odom_cam = Eigen::Isometry3d::Identity();
     bool referable = true;  // false once its filter clone is known to be missing
   };
@@ -102,6 +103,7 @@ class KeyframeVisualOdometry {
   std::vector<cv::Point2f> predicted_;
   std::vector<float> predicted_disparity_;
   std::vector<StereoPoint> kf_points_, cur_points_;
+  std::vector<StereoObservation> kf_seen_, cur_seen_;
   std::vector<int> index_;
 };
 

@@ -39,7 +39,8 @@ struct SplitMix {
 
 }  // namespace
 
-StereoPoseEstimator::StereoPoseEstimator(const VoOptions& options) : options_(options) {}
+StereoPoseEstimator::StereoPoseEstimator(const VoOptions& options, const RectifiedStereoCamera& camera)
+    : options_(options), bundle_(camera, options.pixel_sigma) {}
 
 bool StereoPoseEstimator::GaussNewtonStep(std::span<const StereoPoint> kf, std::span<const StereoPoint> cur,
                                           const std::vector<uint8_t>& mask, Eigen::Matrix3d* R,
@@ -123,12 +124,61 @@ bool StereoPoseEstimator::Refine(std::span<const StereoPoint> kf, std::span<cons
   return true;
 }
 
-PoseEstimate StereoPoseEstimator::Estimate(std::span<const StereoPoint> kf, std::span<const StereoPoint> cur,
+Matrix6d StereoPoseEstimator::AlignmentInformation(std::span<const StereoPoint> kf,
+                                                   std::span<const StereoPoint> cur, const Eigen::Matrix3d& R,
+                                                   const Eigen::Vector3d& t, double* chi2) const {
+  // J = W [I, -R [p_cur]x] for [dt; dtheta] with R <- R Exp(dtheta).
+  Matrix6d H = Matrix6d::Zero();
+  *chi2 = 0.0;
+  for (size_t i = 0; i < kf.size(); ++i) {
+    if (!inliers_[i]) continue;
+    Eigen::Matrix3d W;
+    if (!Whitening(kf[i], cur[i], R, &W)) continue;
+    Eigen::Matrix<double, 3, 6> J;
+    J.leftCols<3>() = W;
+    J.rightCols<3>() = -W * R * so3::Skew(cur[i].p);
+    H.noalias() += J.transpose() * J;
+    *chi2 += (W * (R * cur[i].p + t - kf[i].p)).squaredNorm();
+  }
+  return H;
+}
+
+bool StereoPoseEstimator::Adjust(std::span<const StereoObservation> kf_seen,
+                                 std::span<const StereoObservation> cur_seen, std::span<const StereoPoint> kf,
+                                 Eigen::Matrix3d* R, Eigen::Vector3d* t, Matrix6d* information, double* chi2,
+                                 int* inliers) {
+  BundleResult b;
+  const int iterations = static_cast<int>(options_.bundle_iterations);
+  if (!bundle_.Adjust(kf_seen, cur_seen, kf, inliers_, *R, *t, iterations, &b)) return false;
+  // A pair the alignment accepted can still disagree with the pixels of the other frame once the
+  // points are free; about chi-square(3) per pair, so the same threshold.
+  const std::vector<double>& c = bundle_.point_chi2();
+  bool dropped = false;
+  for (size_t i = 0; i < inliers_.size(); ++i) {
+    if (inliers_[i] && !(c[i] < options_.inlier_chi2)) {
+      inliers_[i] = 0;
+      dropped = true;
+    }
+  }
+  if (dropped && !bundle_.Adjust(kf_seen, cur_seen, kf, inliers_, b.R, b.t, iterations, &b)) return false;
+  *R = b.R;
+  *t = b.t;
+  *information = b.information;
+  *chi2 = b.chi2;
+  *inliers = b.points;
+  return true;
+}
+
+PoseEstimate StereoPoseEstimator::Estimate(std::span<const StereoObservation> kf_seen,
+                                           std::span<const StereoObservation> cur_seen,
+                                           std::span<const StereoPoint> kf, std::span<const StereoPoint> cur,
                                            uint64_t seed) {
   PoseEstimate out;
-  const size_t n = std::min(kf.size(), cur.size());
+  const size_t n = std::min({kf.size(), cur.size(), kf_seen.size(), cur_seen.size()});
   kf = kf.first(n);
   cur = cur.first(n);
+  kf_seen = kf_seen.first(n);
+  cur_seen = cur_seen.first(n);
   inliers_.assign(n, 0);
   candidate_.assign(n, 0);
   if (n < static_cast<size_t>(std::max<int64_t>(3, options_.min_inliers))) {
@@ -225,19 +275,21 @@ PoseEstimate StereoPoseEstimator::Estimate(std::span<const StereoPoint> kf, std:
     return out;
   }
 
-  // Covariance: inverse of J^T J of the whitened residuals, J = W [I, -R [p_cur]x] for
-  // [dt; dtheta] with R <- R Exp(dtheta).
-  Matrix6d H = Matrix6d::Zero();
+  // Covariance: the inverse of the information of the stage that gave the pose.
+  Matrix6d H;
   double chi2 = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    if (!inliers_[i]) continue;
-    Eigen::Matrix3d W;
-    if (!Whitening(kf[i], cur[i], R, &W)) continue;
-    Eigen::Matrix<double, 3, 6> J;
-    J.leftCols<3>() = W;
-    J.rightCols<3>() = -W * R * so3::Skew(cur[i].p);
-    H.noalias() += J.transpose() * J;
-    chi2 += (W * (R * cur[i].p + t - kf[i].p)).squaredNorm();
+  if (options_.bundle_iterations > 0) {
+    if (!Adjust(kf_seen, cur_seen, kf, &R, &t, &H, &chi2, &best)) {
+      out.status = VoStatus::kDegenerate;
+      return out;
+    }
+    out.inliers = best;
+    if (best < options_.min_inliers) {
+      out.status = VoStatus::kTooFewInliers;
+      return out;
+    }
+  } else {
+    H = AlignmentInformation(kf, cur, R, t, &chi2);
   }
   out.rms_mahalanobis = std::sqrt(chi2 / (3.0 * best));
   Vector6d ev;

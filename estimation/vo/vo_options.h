@@ -48,6 +48,9 @@ struct VoOptions {
   double inlier_chi2 = 11.34;  // 3-DoF chi-square at 99 %
   int64_t min_inliers = 15;
   int64_t refine_iterations = 10;
+  // Then a two-frame bundle adjustment of the inliers (points as variables, reprojection error
+  // in both frames), whose pose and covariance are the result; 0 keeps the alignment's.
+  int64_t bundle_iterations = 10;
 
   // Failure checks. A frame whose mean gray value is outside [min_mean, max_mean] or whose
   // standard deviation is below min_contrast is blank or over-exposed.
@@ -94,6 +97,7 @@ struct VoOptions {
     v.Number("inlier_chi2", inlier_chi2, 0.1, 1000.0, "chi-square");
     v.Integer("min_inliers", min_inliers, 3, 5000, "matches");
     v.Integer("refine_iterations", refine_iterations, 1, 100, "iterations");
+    v.Integer("bundle_iterations", bundle_iterations, 0, 100, "iterations");
     v.Number("min_mean", min_mean, 0.0, 255.0, "gray levels");
     v.Number("max_mean", max_mean, 0.0, 255.0, "gray levels");
     v.Number("min_contrast", min_contrast, 0.0, 128.0, "gray levels");
