@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/json_writer.h"
+#include "estimation/graph/pairwise_consistency.h"
 #include "mapping/matching/submap_feature_extractor.h"
 #include "mapping/matching/submap_matcher.h"
 #include "mapping/submap_codec.h"
@@ -223,6 +224,8 @@ int RunBenchMatch(const CommandArgs& args) {
               feature_ms.empty() ? NAN : *std::max_element(feature_ms.begin(), feature_ms.end()));
   const SubmapMatcher matcher(matcher_options);
   std::vector<double> match_ms, good_error_m, good_error_deg, nees;
+  size_t nees_inside = 0;
+  const double chi2_95 = ChiSquareQuantile(0.95, 4);
   size_t positives = 0, found = 0, matched = 0, correct = 0, negatives = 0, false_matches = 0;
   for (size_t i = 0; i < submaps.size(); ++i) {
     for (size_t j = i + 1; j < submaps.size(); ++j) {
@@ -247,6 +250,7 @@ int RunBenchMatch(const CommandArgs& args) {
         Eigen::Vector4d d = r.T_a_b.ToVector() - truth.ToVector();
         d[3] = WrapAngle(d[3]);
         nees.push_back(d.dot(r.covariance.ldlt().solve(d)));
+        nees_inside += nees.back() <= chi2_95 ? 1 : 0;
       }
       if (good) {
         good_error_m.push_back(error.translation().norm());
@@ -263,8 +267,8 @@ int RunBenchMatch(const CommandArgs& args) {
                   b.robot.c_str(), static_cast<unsigned long long>(b.id), 100.0 * overlap,
                   std::string(MatchStatusName(r.status)).c_str());
       if (r.matched()) {
-        std::printf(" error %.3f m %.2f deg, grey levels %.3f", error.translation().norm(),
-                    std::abs(error.yaw()) * 180 / M_PI, r.photometric.ncc);
+        std::printf(" error %.3f m %.2f deg, NEES %.1f, grey levels %.3f", error.translation().norm(),
+                    std::abs(error.yaw()) * 180 / M_PI, nees.back(), r.photometric.ncc);
         if (r.dof == 6) std::printf(", tilt %.2f deg", r.tilt * 180 / M_PI);
       }
       std::printf(" (%s)", r.reason.c_str());
@@ -284,8 +288,9 @@ int RunBenchMatch(const CommandArgs& args) {
   const double nees_mean =
       nees.empty() ? NAN : std::accumulate(nees.begin(), nees.end(), 0.0) / static_cast<double>(nees.size());
   std::printf(
-      "  NEES of every match (4 where the covariance is right): mean %.1f, median %.1f over %zu matches\n",
-      nees_mean, Median(nees), nees.size());
+      "  NEES of every match (4 where the covariance is right): mean %.1f, median %.1f over %zu matches, %zu "
+      "inside the 95 %% bound (%.2f)\n",
+      nees_mean, Median(nees), nees.size(), nees_inside, chi2_95);
   return 0;
 }
 

@@ -37,8 +37,8 @@ class PhotometricAgreement {
                          const Eigen::Isometry3d& T_a_b) const;
 
   // x, y and yaw of `start` moved to where B's grey levels correlate best with A's, by a pattern
-  // search from steps of `step_translation` and `step_yaw` (about B's centroid) halved down to a
-  // tenth (z is kept):
+  // search from steps of `step_translation` and `step_yaw` (yaw about the overlap's centre) halved
+  // down to a tenth (z is kept):
   // where the ground is smooth, the ICP leaves yaw and the slide along a rim to chance, which the
   // albedo pattern pins down. At most `max_scores` scores; `best`, if given, gets the final one.
   FourDofTransform Refine(const std::vector<Eigen::Vector3d>& cloud, const std::vector<float>& grey,
