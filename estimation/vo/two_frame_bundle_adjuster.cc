@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "estimation/math/small_cholesky.h"
@@ -121,7 +122,11 @@ bool TwoFrameBundleAdjuster::Adjust(std::span<const StereoObservation> kf_seen,
   seen_cur_.clear();
   X_.clear();
   for (size_t i = 0; i < n; ++i) {
-    if (!mask[i] || !Finite(kf_seen[i]) || !Finite(cur_seen[i]) || !kf_points[i].p.allFinite()) continue;
+    if (!mask[i]) continue;
+    if (!Finite(kf_seen[i]) || !Finite(cur_seen[i]) || !kf_points[i].p.allFinite()) {
+      point_chi2_[i] = std::numeric_limits<double>::infinity();
+      continue;
+    }
     index_.push_back(static_cast<int>(i));
     seen_kf_.push_back(kf_seen[i]);
     seen_cur_.push_back(cur_seen[i]);

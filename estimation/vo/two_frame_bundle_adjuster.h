@@ -47,7 +47,8 @@ class TwoFrameBundleAdjuster {
               const Eigen::Vector3d& t, int max_iterations, BundleResult* result);
 
   // Whitened squared reprojection error of each adjusted pair in both frames (about chi-square
-  // with 3 degrees of freedom: 6 residuals, 3 fitted coordinates); 0 for pairs not adjusted.
+  // with 3 degrees of freedom: 6 residuals, 3 fitted coordinates); 0 for pairs outside the mask,
+  // infinity for pairs in it that are not finite.
   const std::vector<double>& point_chi2() const { return point_chi2_; }
 
  private:
