@@ -47,8 +47,23 @@ for i in "${!robots[@]}"; do
     --out "$out/$r" &
   pids+=($!)
 done
+# The first robot to fail stops the others: they would wait out team.linger for it.
 status=0
-for pid in "${pids[@]}"; do wait "$pid" || status=1; done
+running=("${pids[@]}")
+while ((${#running[@]} > 0)); do
+  finished=""
+  if ! wait -n -p finished "${running[@]}"; then
+    status=1
+    kill -TERM "${running[@]}" 2>/dev/null || true
+    sleep 5
+    kill -KILL "${running[@]}" 2>/dev/null || true
+    wait || true
+    break
+  fi
+  left=()
+  for pid in "${running[@]}"; do [[ $pid == "$finished" ]] || left+=("$pid"); done
+  running=("${left[@]}")
+done
 if ((status != 0)); then
   echo "demo: a simulated robot's cairnd failed (see above)" >&2
   exit 1
