@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "estimation/testing/stereo_matches.h"
 #include "estimation/vo/keyframe_visual_odometry.h"
 #include "estimation/vo/stereo_feature_tracker.h"
 #include "estimation/vo/stereo_pose_estimator.h"
@@ -55,11 +56,6 @@ struct TrueCorner {
   StereoObservation observed;
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
 };
-
-StereoObservation Project(const RectifiedStereoCamera& c, const Eigen::Vector3d& p) {
-  const double u = c.f * p.x() / p.z() + c.cx;
-  return {u, u - c.f * c.baseline / p.z(), c.f * p.y() / p.z() + c.cy};
-}
 
 }  // namespace
 
@@ -144,7 +140,7 @@ int RunBenchVoScale(const CommandArgs& args) {
     std::vector<float> predicted_disparity;
     std::vector<StereoObservation> truth;
     for (const TrueCorner& c : corners) {
-      const StereoObservation t = Project(cam, T_1_0 * c.p);
+      const StereoObservation t = testing::ObserveStereo(cam, T_1_0 * c.p);
       from.emplace_back(static_cast<float>(c.observed.u_left), static_cast<float>(c.observed.v));
       predicted.emplace_back(static_cast<float>(t.u_left + 0.7), static_cast<float>(t.v - 0.4));
       predicted_disparity.push_back(static_cast<float>(c.observed.u_left - c.observed.u_right));
@@ -172,7 +168,7 @@ int RunBenchVoScale(const CommandArgs& args) {
           !TriangulateStereo(cam, tracked[i], options.pixel_sigma, options.min_disparity, &b) ||
           b.cov(2, 2) > options.max_depth_error * options.max_depth_error)
         continue;
-      const StereoObservation exact_0 = Project(cam, corners[i].p);
+      const StereoObservation exact_0 = testing::ObserveStereo(cam, corners[i].p);
       if (!TriangulateStereo(cam, exact_0, options.pixel_sigma, 0.0, &a_exact) ||
           !TriangulateStereo(cam, truth[i], options.pixel_sigma, 0.0, &b_exact))
         continue;
