@@ -119,6 +119,8 @@ std::string BuildTeamJson(const TeamReport& r, const TeamFile& team, const Graph
     j.Field("team_matches", g.team_matches);
     j.Field("team_factors", g.team_factors);
     j.Field("team_matches_pending", g.team_matches_pending);
+    j.Field("team_matches_held", g.team_matches_held);
+    j.Field("team_matches_rejected", g.team_matches_rejected);
   }
   j.Key("errors").BeginArray();
   for (const std::string& e : r.errors) j.String(e);

@@ -50,6 +50,7 @@ GraphStage::GraphStage(const GraphStageOptions& options, bool deterministic)
       graph_(options_.optimizer),
       robot_(options_.optimizer.own_robot),
       trajectories_(robot_),
+      screen_(options_.team_matches),
       gnss_(options_.gnss) {}
 
 uint64_t GraphStage::OriginKey(uint64_t frame_id) const {
@@ -80,6 +81,7 @@ bool GraphStage::Add(const SlamFactor& f) {
     return false;
   }
   ++report_.factors;
+  if (f.kind == FactorKind::kFrameSwitch) screen_.AddFrameSwitch(f);
   if (f.kind == FactorKind::kLandmark) {
     ++outside_ties_[RobotOfVariable(f.a)];
   } else if ((f.kind == FactorKind::kMatch || f.kind == FactorKind::kDetection) &&
@@ -126,6 +128,7 @@ void GraphStage::OnEstimate(const FrameEstimate& e) {
     return;
   }
   trajectories_.AddOwnEstimate(PlacedEstimate{e.time, e.frame_id, e.T_frame_body});
+  if (screen_.held() != 0) TakeScreenedMatches(false);
   if (!pending_detections_.empty()) RetryPendingDetections();
   if (!pending_fixes_.empty()) RetryPendingFixes();
   if ((trajectories_.Own().size() - 1) % static_cast<uint64_t>(options_.pose_every) != 0) return;
@@ -169,6 +172,7 @@ void GraphStage::OnFrameSwitch(const FrameSwitchEvent& e) {
 
 void GraphStage::Finish() {
   if (graph_.num_factors() == 0) return;
+  TakeScreenedMatches(true);
   if (!pending_fixes_.empty()) RetryPendingFixes();
   const SlamUpdateStats stats = graph_.SolveFinal();
   if (stats.solved) ++report_.solves;
@@ -183,7 +187,9 @@ Status GraphStage::AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTra
 }
 
 Status GraphStage::AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64_t frame_b,
-                            const FourDofTransform& T_a_b, const Eigen::Matrix4d& covariance, double tilt_sigma) {
+                            const FourDofTransform& T_a_b, const Eigen::Matrix4d& covariance,
+                            double tilt_sigma, bool* held) {
+  if (held != nullptr) *held = false;
   const uint64_t key_a = VariableKey(VariableKind::kSubmap, robot_a, frame_a);
   const uint64_t key_b = VariableKey(VariableKind::kSubmap, robot_b, frame_b);
   if (!graph_.HasVariable(key_a) || !graph_.HasVariable(key_b))
@@ -203,16 +209,45 @@ Status GraphStage::AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64
   f.b = key_b;
   f.z = ToPose3(T_a_b.ToIsometry());
   f.information = Floored(c).inverse();
+  if (robot_a == robot_b) return AddMatchFactor(f);
+  if (!f.information.allFinite() || !f.z.t.allFinite() || !f.z.q.coeffs().allFinite() ||
+      f.information.llt().info() != Eigen::Success) {
+    ++report_.rejected_factors;
+    const std::string what = "match with a non-finite measurement or covariance";
+    Error(what);
+    return InvalidArgumentError(what);
+  }
+  screen_.Offer(f, last_time());
+  if (held != nullptr) *held = true;
+  TakeScreenedMatches(false);
+  return Status::Ok();
+}
+
+Status GraphStage::AddMatchFactor(const SlamFactor& f) {
   const size_t rejected = report_.rejected_factors;
   if (!Add(f)) return InvalidArgumentError(report_.errors.empty() || report_.rejected_factors == rejected
                                                ? "the graph refused the match"
                                                : report_.errors.back());
   ++report_.matches;
-  if (robot_a != robot_b) ++report_.team_matches;
+  const bool team = RobotOfVariable(f.a) != RobotOfVariable(f.b);
+  if (team) ++report_.team_matches;
   Update();
   // A match may tie a teammate's subgraph, whose fixes wait for that.
-  if (robot_a != robot_b && !pending_fixes_.empty()) RetryPendingFixes();
+  if (team && !pending_fixes_.empty()) RetryPendingFixes();
   return Status::Ok();
+}
+
+void GraphStage::TakeScreenedMatches(bool final) {
+  for (const ScreenedMatch& m : screen_.Decide(last_time(), final)) {
+    if (!m.accepted) {
+      ++report_.team_matches_rejected;
+      Error(m.reason);
+      continue;
+    }
+    // Refusals are counted and named by Add().
+    (void)AddMatchFactor(m.factor);
+  }
+  report_.team_matches_held = screen_.held();
 }
 
 Matrix6d GraphStage::SwitchInformation(const Matrix6d& covariance, const Eigen::Isometry3d& T_old_new) const {

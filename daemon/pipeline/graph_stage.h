@@ -44,6 +44,8 @@ struct GraphStageReport {
   uint64_t team_inputs = 0;      // teammates' items taken
   uint64_t team_factors = 0;     // teammates' w, v and c factors added
   uint64_t team_matches_pending = 0;  // waiting for an origin not in the graph yet
+  uint64_t team_matches_held = 0;     // waiting for the screen (TeamMatchScreen)
+  uint64_t team_matches_rejected = 0;  // the screen found them contradicting accepted ones
   uint64_t plane_landmarks = 0;       // plane landmarks l started
   uint64_t plane_observations = 0;    // their observations o added (own and teammates')
   uint64_t plane_observations_pending = 0;  // a teammate's, its submap not tied to this robot's yet
@@ -101,9 +103,12 @@ class GraphStage {
   // Cauchy loss; the graph re-optimizes. An error says why the graph refused it.
   Status AddMatch(uint64_t frame_a, uint64_t frame_b, const FourDofTransform& T_a_b,
                   const Eigen::Matrix4d& covariance, double tilt_sigma);
-  // The same between origins of any robots of the team, by graph letter.
-  Status AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64_t frame_b, const FourDofTransform& T_a_b,
-                  const Eigen::Matrix4d& covariance, double tilt_sigma);
+  // The same between origins of any robots of the team, by graph letter. A match between two
+  // robots goes to the team screen first (`*held` set): it enters once the screen accepts it, or
+  // is counted and named in the errors when the screen rejects it.
+  Status AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64_t frame_b,
+                  const FourDofTransform& T_a_b, const Eigen::Matrix4d& covariance, double tilt_sigma,
+                  bool* held = nullptr);
   // A teammate's item: its frame switches w and poses v join the graph under its letter (a
   // floating subgraph until a match or detection ties it to this robot's), its estimates make its
   // global trajectory, and matches it made are added (once both origins are known).
@@ -239,7 +244,12 @@ class GraphStage {
     double tilt_sigma;
   };
   std::vector<PendingMatch> pending_matches_;
+  TeamMatchScreen screen_;
   void RetryPendingMatches();
+  // Adds the matches the team screen accepted, counts and names those it rejected.
+  void TakeScreenedMatches(bool final);
+  // Adds a match factor the screen let through (or one of the robot's own).
+  Status AddMatchFactor(const SlamFactor& f);
   std::vector<TeamPlaneObservation> pending_planes_;
   std::set<std::pair<uint64_t, uint64_t>> structure_factors_;  // (origin, landmark) held
   void RetryPendingPlanes();

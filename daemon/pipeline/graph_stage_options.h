@@ -9,6 +9,7 @@
 #include "common/options_visitor.h"
 #include "daemon/pipeline/gnss_fix_factors.h"
 #include "estimation/graph/slam_graph.h"
+#include "estimation/graph/team_match_screen.h"
 
 namespace cairn {
 
@@ -23,6 +24,9 @@ struct GraphStageOptions {
   double min_rotation_sigma = 0.001;  // rad
   bool write_g2o = true;              // OUT/graph.g2o at the end
   SlamGraphOptions optimizer;
+  // Matches between two robots are tested against each other before they enter (a wrong first
+  // tie cannot be undone by the graph's robust loss).
+  TeamMatchScreenOptions team_matches;
   GnssFixOptions gnss;  // fixes as factors on the team's datum (off by default)
 
   void Visit(OptionsVisitor& v) {
@@ -32,6 +36,7 @@ struct GraphStageOptions {
     v.Number("min_rotation_sigma", min_rotation_sigma, 1e-6, 1.0, "rad");
     v.Flag("write_g2o", write_g2o);
     v.Section("optimizer", optimizer);
+    v.Section("team_matches", team_matches);
     v.Section("gnss", gnss);
   }
 };

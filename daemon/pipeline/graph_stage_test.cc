@@ -346,6 +346,16 @@ Eigen::Isometry3d Offset() {
   return T;
 }
 
+// Teammate b's global trajectory (100 estimates) lies within `tolerance` of the truth.
+void ExpectTeammateWhereItWas(const GraphStage& g, const Drive& b, double tolerance) {
+  const Trajectory tb = g.GlobalTrajectory('b');
+  ASSERT_EQ(tb.poses.size(), 100u);
+  for (size_t i = 0; i < tb.poses.size(); i += 9) {
+    const Eigen::Isometry3d truth = Offset() * b.T_world_body[i];
+    EXPECT_LT((tb.poses[i].T_frame_body.translation() - truth.translation()).norm(), tolerance) << i;
+  }
+}
+
 TeamDetection Sighting(const Drive& a, const Drive& b, size_t i, double time_shift = 0.0) {
   TeamDetection d;
   d.time = Timestamp::FromNanoseconds(int64_t{100000000} * static_cast<int64_t>(i) + std::llround(time_shift * 1e9));
@@ -374,15 +384,71 @@ TEST(GraphStageTest, ADetectionTiesATeammatesFloatingSubgraphToOurs) {
   EXPECT_EQ(g.OutsideTies('a'), 1u);
   EXPECT_EQ(g.OutsideTies('b'), 1u);
   g.Finish();
-  const Trajectory tb = g.GlobalTrajectory('b');
-  ASSERT_EQ(tb.poses.size(), 100u);
   // One sighting fixes the whole rigid subgraph: every estimate lands where it truly was.
-  for (size_t i = 0; i < tb.poses.size(); i += 9) {
-    const Eigen::Isometry3d truth = Offset() * b.T_world_body[i];
-    EXPECT_LT((tb.poses[i].T_frame_body.translation() - truth.translation()).norm(), 0.05) << i;
-  }
+  ExpectTeammateWhereItWas(g, b, 0.05);
   ASSERT_EQ(g.detections().size(), 1u);
   EXPECT_EQ(g.detections()[0].status, "factor");
+}
+
+// Two matches tie a teammate at once, one of them 0.22 m and 1.4 deg off (a small overlap's). The
+// graph takes neither until the team screen has waited for a third opinion; then the better
+// determined one ties the teammate, the other is rejected and named, and the teammate lands right.
+TEST(GraphStageTest, DisagreeingFirstMatchesWithATeammateWaitAndOnlyTheRightOneTiesIt) {
+  const Drive a = MakeDrive(100, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStageOptions options = Options();
+  options.team_matches.hold_seconds = 3.0;
+  GraphStage g(options, true);
+  const size_t half = 52;  // a's frames 0 and 1, up to 5 s
+  for (size_t i = 0; i < half; ++i) g.OnInput(a.inputs[i]);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 7)) g.OnTeamInput(in);
+  ASSERT_FALSE(g.Connected('b'));
+  auto match = [&](uint64_t fa, uint64_t fb, const Eigen::Isometry3d& error, double scale) {
+    const Eigen::Isometry3d T = a.T_world_frame.at(fa).inverse() * Offset() * b.T_world_frame.at(fb) * error;
+    bool held = false;
+    const Status s =
+        g.AddMatch('a', fa, 'b', fb, FourDofTransform::ProjectIsometry(T),
+                   scale * Eigen::Vector4d(4e-4, 4e-4, 4e-4, 1e-5).asDiagonal().toDenseMatrix(), 0.01, &held);
+    EXPECT_TRUE(s.ok()) << s.ToString();
+    EXPECT_TRUE(held);
+  };
+  Eigen::Isometry3d wrong = Eigen::Isometry3d::Identity();
+  wrong.translation() = Eigen::Vector3d(0.22, 0.0, 0.0);
+  wrong.linear() =
+      Eigen::AngleAxisd(1.4 * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  match(0, 0, wrong, 1.5);
+  match(1, 1, Eigen::Isometry3d::Identity(), 1.0);
+  EXPECT_EQ(g.report().team_matches_held, 2u);
+  EXPECT_EQ(g.report().team_matches, 0u);
+  EXPECT_FALSE(g.Connected('b'));
+  for (size_t i = half; i < a.inputs.size(); ++i) g.OnInput(a.inputs[i]);
+  const GraphStageReport r = g.report();
+  EXPECT_EQ(r.team_matches_held, 0u);
+  EXPECT_EQ(r.team_matches, 1u);
+  EXPECT_EQ(r.team_matches_rejected, 1u);
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_NE(r.errors[0].find("a/0 - b/0 disagrees with the accepted match a/1 - b/1"), std::string::npos)
+      << r.errors[0];
+  ASSERT_TRUE(g.Connected('b'));
+  g.Finish();
+  ExpectTeammateWhereItWas(g, b, 0.05);
+}
+
+// A lone first match with a teammate enters at the end of the run at the latest.
+TEST(GraphStageTest, ALoneTeamMatchEntersWhenTheRunEnds) {
+  const Drive a = MakeDrive(40, 25);
+  const Drive b = MakeDrive(100, 20);
+  GraphStage g(Options(), true);  // the shipped 30 s hold: longer than the run
+  for (const GraphInput& in : a.inputs) g.OnInput(in);
+  for (const TeamInput& in : TeamInputsOf(b, 'b', 7)) g.OnTeamInput(in);
+  const Eigen::Isometry3d T = a.T_world_frame.at(1).inverse() * Offset() * b.T_world_frame.at(2);
+  ASSERT_TRUE(g.AddMatch('a', 1, 'b', 2, FourDofTransform::ProjectIsometry(T),
+                         Eigen::Matrix4d::Identity() * 1e-4, 0.01)
+                  .ok());
+  EXPECT_FALSE(g.Connected('b'));
+  g.Finish();
+  EXPECT_TRUE(g.Connected('b'));
+  EXPECT_EQ(g.report().team_matches, 1u);
 }
 
 // IPPE's flip tilts the seen tag: a sighting whose rotation turns b's up 60 deg away from a's is
@@ -725,13 +791,7 @@ TEST(GraphStageTest, ATeammatesGnssFixesWaitUntilItsSubgraphIsTied) {
   EXPECT_EQ(r.gnss_pending, 0u);
   EXPECT_EQ(r.rejected_factors, 0u);
   // b's fixes agree with the sighting: its trajectory stays where it truly was.
-  const Trajectory tb = g.GlobalTrajectory('b');
-  ASSERT_EQ(tb.poses.size(), 100u);
-  for (size_t i = 0; i < tb.poses.size(); i += 9) {
-    EXPECT_LT((tb.poses[i].T_frame_body.translation() - (Offset() * b.T_world_body[i]).translation()).norm(),
-              0.05)
-        << i;
-  }
+  ExpectTeammateWhereItWas(g, b, 0.05);
 }
 
 // Robots that never meet: a teammate's subgraph, neither matched nor seen, is placed by its own
@@ -772,13 +832,7 @@ TEST(GraphStageTest, ATeammateNeverMetIsPlacedByItsGnssFixes) {
   EXPECT_EQ(r.gnss_pending, 0u);
   EXPECT_EQ(r.detections, 0u);
   EXPECT_EQ(r.team_matches, 0u);
-  const Trajectory tb = g.GlobalTrajectory('b');
-  ASSERT_EQ(tb.poses.size(), 100u);
-  for (size_t i = 0; i < tb.poses.size(); i += 9) {
-    EXPECT_LT((tb.poses[i].T_frame_body.translation() - (Offset() * b.T_world_body[i]).translation()).norm(),
-              0.1)
-        << i;
-  }
+  ExpectTeammateWhereItWas(g, b, 0.1);
 }
 
 }  // namespace

@@ -196,10 +196,11 @@ void SubmapMatchingStage::Take(Done done, GraphStage& graph) {
     ++report_.matched;
     const char letter_a = pair.a.robot == robot_ ? graph.robot() : letters_.count(pair.a.robot) ? letters_.at(pair.a.robot) : 0;
     const char letter_b = pair.b.robot == robot_ ? graph.robot() : letters_.count(pair.b.robot) ? letters_.at(pair.b.robot) : 0;
+    bool held = false;
     const Status s = graph.AddMatch(letter_a, pair.a.id, letter_b, pair.b.id, attempt.result.T_a_b,
-                                    attempt.result.covariance, options_.tilt_sigma);
+                                    attempt.result.covariance, options_.tilt_sigma, &held);
     attempt.accepted = s.ok();
-    attempt.verdict = s.ok() ? "added" : s.ToString();
+    attempt.verdict = !s.ok() ? s.ToString() : held ? "to the team screen" : "added";
     if (s.ok()) {
       ++report_.accepted;
       estimates_stale_ = true;

@@ -14,16 +14,6 @@
 namespace cairn {
 namespace {
 
-// Adjoint of T for the [t; rotation] tangent order of the edges' information.
-Matrix6d Adjoint(const Pose3& T) {
-  const Eigen::Matrix3d R = T.R();
-  Matrix6d A = Matrix6d::Zero();
-  A.topLeftCorner<3, 3>() = R;
-  A.topRightCorner<3, 3>() = so3::Skew(T.t) * R;
-  A.bottomRightCorner<3, 3>() = R;
-  return A;
-}
-
 Matrix6d Covariance(const Matrix6d& information) {
   return information.ldlt().solve(Matrix6d::Identity());
 }

@@ -8,6 +8,15 @@
 
 namespace cairn {
 
+Matrix6d Adjoint(const Pose3& T) {
+  const Eigen::Matrix3d R = T.R();
+  Matrix6d A = Matrix6d::Zero();
+  A.topLeftCorner<3, 3>() = R;
+  A.topRightCorner<3, 3>() = so3::Skew(T.t) * R;
+  A.bottomRightCorner<3, 3>() = R;
+  return A;
+}
+
 size_t PoseGraph::SetVertex(uint64_t id, const Pose3& pose) {
   const size_t i = IndexOf(id);
   poses_[i] = pose;

@@ -29,6 +29,10 @@ struct Pose3 {
 using Matrix6d = Eigen::Matrix<double, 6, 6>;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
+// Adjoint of T for the [t; rotation] tangent order: T Exp(xi) = Exp(Adjoint(T) xi) T, to first
+// order also for the factors' perturbation (t + R dt, R Exp(dr)).
+Matrix6d Adjoint(const Pose3& T);
+
 // Multi-robot keys: the robot letter ('a', 'b', ...) in the top byte, the index below.
 constexpr uint64_t MakeRobotKey(char robot, uint64_t index) {
   return (static_cast<uint64_t>(static_cast<unsigned char>(robot)) << 56) | index;
