@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
@@ -431,7 +432,17 @@ int Cairnd::Run() {
   notifier.Stopping();
   for (auto& s : sources_) s->Stop();
   if (stamper) run.trigger_stamping = stamper->counts();
-  pipeline.StopAndDrain();  // with a team: lingers until the teammates hold the same logs
+  // With a team: lingers until the teammates hold the same logs; after a stop signal briefly, and
+  // a second signal ends it.
+  const bool signalled = run.stop_reason == "signal";
+  pipeline.StopAndDrain(
+      signalled ? options_.team.stop_linger : std::numeric_limits<double>::infinity(), [&set] {
+        timespec now{0, 0};
+        const int sig = sigtimedwait(&set, nullptr, &now);
+        if (sig != SIGTERM && sig != SIGINT) return false;
+        spdlog::warn("{} received again: ending the team's linger", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+        return true;
+      });
   if (comms) {
     comms->Stop();
     run.extra_executors.push_back(comms->executor_report());
@@ -515,7 +526,11 @@ Status Cairnd::WriteOutputs(const RunInfo& run, const Pipeline& pipeline, const 
           if (!t.poses.empty()) CAIRN_RETURN_IF_ERROR(WriteTrajectory(dir + "/global_trajectory_" + name, t));
         }
       }
-      CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/team.json", BuildTeamJson(comms->report(), comms->team(), graph)));
+      TeamReport team_report = comms->report();
+      team_report.linger_seconds = pipeline.linger().seconds;
+      team_report.linger_ended = pipeline.linger().ended;
+      CAIRN_RETURN_IF_ERROR(
+          WriteFileAtomically(dir + "/team.json", BuildTeamJson(team_report, comms->team(), graph)));
     }
     if (options_.graph.write_g2o) {
       CAIRN_RETURN_IF_ERROR(WriteFileAtomically(dir + "/graph.g2o", FormatG2o(graph->ExportPoseGraph())));

@@ -17,6 +17,9 @@ std::string BuildTeamJson(const TeamReport& r, const TeamFile& team, const Graph
   j.Field("incarnation", r.incarnation);
   j.Field("seconds", r.seconds);
   j.Field("settled", r.settled);
+  j.Key("linger").BeginObject();
+  j.Field("seconds", r.linger_seconds).Field("ended", r.linger_ended);
+  j.EndObject();
   j.Key("robots").BeginArray();
   for (const TeamMember& m : team.members) {
     const char letter = m.letter[0];

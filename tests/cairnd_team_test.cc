@@ -74,6 +74,14 @@ void GenerateKeys(const std::string& keys_dir, const std::vector<std::string>& n
 // Ports of this test process (`slot` 0-7 of its block), apart from other tests' processes.
 int TeamPort(int slot) { return 20000 + static_cast<int>(getpid() % 2000) * 8 + slot; }
 
+// A team of a rover ('a') and a hexacopter ('b'): their keys in dir/keys, dir/team.yaml.
+void WriteRoverAndHexacopter(const std::string& dir, int slot, Member* rover, Member* hexacopter) {
+  ASSERT_NO_FATAL_FAILURE(GenerateKeys(dir + "/keys", {"rover", "hexacopter"}));
+  *rover = Member{"rover", "a", "rover", TeamPort(slot)};
+  *hexacopter = Member{"hexacopter", "b", "hexacopter", TeamPort(slot) + 1};
+  WriteTeam(dir + "/team.yaml", {*rover, *hexacopter}, dir + "/keys");
+}
+
 std::vector<std::string> TeamArgs(const Member& m, const std::string& team_file, const std::string& key_file,
                                   const std::string& out, double duration = 6.0) {
   return {Cairnd(), "--config", Config(m.profile), "--sim", "--out", out,
@@ -203,11 +211,8 @@ TEST(CairndTeamTest, ARobotKilledAndRestartedLosesAndDuplicatesNothing) {
   const testing::ScopedTempDir temp("cairnd_team_kill");
   const std::string dir = temp.path();
   const std::string keys = dir + "/keys";
-  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
-  const int base = TeamPort(4);
-  const Member rover{"rover", "a", "rover", base};
-  const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
-  WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
+  Member rover, hexacopter;
+  ASSERT_NO_FATAL_FAILURE(WriteRoverAndHexacopter(dir, 4, &rover, &hexacopter));
   testing::ProcessOptions options;
   options.timeout = std::chrono::minutes(8);
   ProcessResult killed, restarted, teammate;
@@ -268,11 +273,8 @@ TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
     ~Unmount() { RunProcess({"/usr/bin/umount", path}); }
   } unmount{store};
   const std::string keys = dir + "/keys";
-  ASSERT_NO_FATAL_FAILURE(GenerateKeys(keys, {"rover", "hexacopter"}));
-  const int base = TeamPort(6);
-  const Member rover{"rover", "a", "rover", base};
-  const Member hexacopter{"hexacopter", "b", "hexacopter", base + 1};
-  WriteTeam(dir + "/team.yaml", {rover, hexacopter}, keys);
+  Member rover, hexacopter;
+  ASSERT_NO_FATAL_FAILURE(WriteRoverAndHexacopter(dir, 6, &rover, &hexacopter));
   auto args = TeamArgs(rover, dir + "/team.yaml", keys + "/rover.key", dir + "/rover", 20.0);
   // Alone (the teammate never comes): only its own items, which fill its 8 KB soon.
   args.insert(args.end(), {"--set", "team.store_dir=" + store, "--set", "team.linger=1"});
@@ -291,6 +293,44 @@ TEST(CairndTeamTest, AFullStoreDiskIsReportedAndTheRobotKeepsEstimating) {
   const JsonValue* self = RobotEntry(t, "rover");
   ASSERT_NE(self, nullptr);
   EXPECT_GT(ItemCount(*self), 0);
+}
+
+// Stopped by a signal (systemctl stop), a robot whose teammate never answers lingers only
+// team.stop_linger, not team.linger: the service's stop timeout would kill it before it wrote its
+// outputs. A second signal ends the linger at once.
+TEST(CairndTeamTest, AStopSignalBoundsTheTeamsLingerAndASecondOneEndsIt) {
+  const testing::ScopedTempDir temp("cairnd_team_stop");
+  const std::string dir = temp.path();
+  const std::string keys = dir + "/keys";
+  Member rover, hexacopter;
+  ASSERT_NO_FATAL_FAILURE(WriteRoverAndHexacopter(dir, 0, &rover, &hexacopter));
+  const auto run = [&](const std::string& out, const std::string& stop_linger, bool twice) {
+    auto args = TeamArgs(rover, dir + "/team.yaml", keys + "/rover.key", out, 60.0);
+    *std::find(args.begin(), args.end(), "team.linger=60") = "team.linger=3600";
+    args.insert(args.end(), {"--set", "team.stop_linger=" + stop_linger, "--log-level", "info"});
+    testing::ProcessOptions options;
+    // Without the bound, the linger (an hour) outlasts this and the test fails.
+    options.timeout = std::chrono::minutes(4);
+    options.signal = SIGTERM;
+    options.signal_when_output_contains = "running";
+    options.signal_after = std::chrono::milliseconds(1500);
+    if (twice) options.signal_again_when_output_contains = "team: exchanging until";
+    return RunProcess(args, options);
+  };
+  const ProcessResult bounded = run(dir + "/bounded", "2", false);
+  ASSERT_EQ(bounded.exit_code, 0) << bounded.output;
+  EXPECT_EQ(JsonValue::ParseFile(dir + "/bounded/summary.json")["stop_reason"].string(), "signal");
+  const JsonValue t = JsonValue::ParseFile(dir + "/bounded/team.json");
+  EXPECT_FALSE(t["settled"].boolean());
+  EXPECT_EQ(t["linger"]["ended"].string(), "time");
+  EXPECT_TRUE(fs::exists(dir + "/bounded/global_trajectory.tum"));
+
+  const ProcessResult cut = run(dir + "/cut", "3600", true);
+  ASSERT_EQ(cut.exit_code, 0) << cut.output;
+  EXPECT_NE(cut.output.find("SIGTERM received again: ending the team's linger"), std::string::npos)
+      << cut.output;
+  EXPECT_EQ(JsonValue::ParseFile(dir + "/cut/team.json")["linger"]["ended"].string(), "cut");
+  EXPECT_TRUE(fs::exists(dir + "/cut/global_trajectory.tum"));
 }
 
 // Deployed from the lander, every robot sees its tags while it initializes: each robot's

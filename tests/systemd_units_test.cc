@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -87,6 +88,26 @@ TEST(SystemdUnitsTest, SysusersAndTmpfilesDeclareTheStateFolder) {
   const std::string src = testing::SourceDir() + "/systemd/";
   EXPECT_NE(Read(src + "cairn.sysusers.conf").find("u cairn "), std::string::npos);
   EXPECT_NE(Read(src + "cairn.tmpfiles.conf").find("d /var/lib/cairn 0750 cairn cairn"), std::string::npos);
+}
+
+// `systemctl stop` waits TimeoutStopSec before it kills: a stopped team robot's linger
+// (team.stop_linger of every shipped profile) must leave it time to write its outputs.
+TEST(SystemdUnitsTest, TheStopTimeoutOutlastsTheTeamsLingerAfterAStop) {
+  const double kWriteSeconds = 15.0;
+  const std::regex timeout_line(R"(\nTimeoutStopSec=([0-9]+)s\n)");
+  const std::regex linger_line(R"(\n  stop_linger: ([0-9.e+]+))");
+  for (const std::string unit : {"cairnd.service.in", "cairnd@.service.in"}) {
+    const std::string text = Read(testing::SourceDir() + "/systemd/" + unit);
+    std::smatch timeout;
+    ASSERT_TRUE(std::regex_search(text, timeout, timeout_line)) << unit;
+    for (const std::string profile : {"rover", "hexacopter", "euroc"}) {
+      const std::string config = Read(testing::SourceDir() + "/configs/" + profile + ".yaml");
+      std::smatch linger;
+      ASSERT_TRUE(std::regex_search(config, linger, linger_line)) << profile;
+      EXPECT_GE(std::stod(timeout[1].str()) - std::stod(linger[1].str()), kWriteSeconds)
+          << unit << ", " << profile;
+    }
+  }
 }
 
 }  // namespace

@@ -54,6 +54,9 @@ struct TeamReport {
   uint64_t decode_errors = 0;
   uint64_t earlier_run_items = 0;  // this robot's items of earlier runs found in the store
   bool settled = false;            // the team held the same logs at the end
+  // How long the end of the run waited for that, and how it ended (Pipeline::LingerReport).
+  double linger_seconds = 0.0;
+  std::string linger_ended;
   std::vector<std::string> errors;  // the first few, verbatim
   std::vector<TeamLinkStatus> links;
 };

@@ -26,6 +26,10 @@ struct TeamOptions {
   // Replays and simulations: after the data ends, how long to go on exchanging until every
   // teammate holds everything (and this robot everything of theirs).
   double linger = 60.0;
+  // After a stop signal (systemctl stop, Ctrl-C), the exchange goes on at most this long: the
+  // service's stop timeout (TimeoutStopSec, 30 s in the shipped units) must also cover writing the
+  // outputs. A second signal ends it at once.
+  double stop_linger = 10.0;
   ExchangeOptions exchange;
   ZmqTransportOptions transport;
 
@@ -37,6 +41,7 @@ struct TeamOptions {
     v.Text("store_dir", store_dir);
     v.Number("pose_batch_interval", pose_batch_interval, 0.01, 3600.0, "s");
     v.Number("linger", linger, 0.0, 86400.0, "s");
+    v.Number("stop_linger", stop_linger, 0.0, 86400.0, "s");
     v.Section("exchange", exchange);
     v.Section("transport", transport);
   }

@@ -194,7 +194,7 @@ void Pipeline::Start() {
   }
 }
 
-void Pipeline::StopAndDrain() {
+void Pipeline::StopAndDrain(double max_linger, const std::function<bool()>& cut_linger) {
   if (!started_) return;
   // Upstream first, so that every stage drains into a consumer that still runs (in deterministic
   // mode a producer waits for its consumer).
@@ -239,13 +239,27 @@ void Pipeline::StopAndDrain() {
       // (or the linger time is over). This thread owns the graph now.
       TakeSubmaps(UINT64_MAX);
       team_->FinishOwnLog();
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(team_->linger_seconds());
-      while (!team_->Settled() && std::chrono::steady_clock::now() < deadline) {
+      const auto start = std::chrono::steady_clock::now();
+      const double limit = std::min(team_->linger_seconds(), max_linger);
+      const auto deadline = start + std::chrono::duration<double>(limit);
+      spdlog::info("team: exchanging until every teammate holds the same items, at most {:.0f} s", limit);
+      linger_.ended = "time";
+      while (std::chrono::steady_clock::now() < deadline) {
+        if (team_->Settled()) {
+          linger_.ended = "settled";
+          break;
+        }
+        if (cut_linger && cut_linger()) {
+          linger_.ended = "cut";
+          break;
+        }
         const bool took = TakeTeamInputs();
         StepSubmapWork();
         team_->SetIdle(!took && (matching_ == nullptr || matching_->Idle()));
         if (!took) std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
+      if (team_->Settled()) linger_.ended = "settled";
+      linger_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       TakeTeamInputs();
     }
     if (matching_) {

@@ -6,10 +6,12 @@
 
 #include <array>
 #include <atomic>
+#include <functional>
+#include <limits>
 #include <map>
-#include <set>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -135,8 +137,18 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   void RequestFrameSwitch(const FrameSwitchRequest& request) override;
   // Starts the stage threads.
   void Start();
-  // Lets the stages consume what is queued, then joins them. Publishing must have stopped.
-  void StopAndDrain();
+  // Lets the stages consume what is queued, then joins them. Publishing must have stopped. With a
+  // team, the exchange goes on until the team holds the same logs, for at most the team's linger
+  // and `max_linger` seconds, and ends early when `cut_linger` (polled) says so.
+  void StopAndDrain(double max_linger = std::numeric_limits<double>::infinity(),
+                    const std::function<bool()>& cut_linger = nullptr);
+  // How the team's linger at the end of the run went: "settled", "time" (its limit passed),
+  // "cut" (cut_linger), or "" (no team).
+  struct LingerReport {
+    double seconds = 0.0;
+    std::string ended;
+  };
+  LingerReport linger() const { return linger_; }
 
   void OnImu(const ImuSample& sample) override;
   void OnStereo(const StereoFrame& frame) override;
@@ -323,6 +335,7 @@ class Pipeline final : public SensorSink, public FrameSwitchRequesterInterface {
   mutable std::mutex fault_mutex_;
   FaultReport faults_;
   bool started_ = false;
+  LingerReport linger_;
 };
 
 }  // namespace cairn

@@ -36,7 +36,8 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const ProcessOpti
   }
   close(pipefd[1]);
   const auto start = std::chrono::steady_clock::now();
-  bool signalled = false;
+  bool signalled = false, signalled_again = false;
+  size_t signalled_at_output = 0;
   std::optional<std::chrono::steady_clock::time_point> armed_at;
   char buf[4096];
   while (true) {
@@ -59,6 +60,13 @@ ProcessResult RunProcess(const std::vector<std::string>& argv, const ProcessOpti
     if (!signalled && options.signal != 0 && armed_at && now - *armed_at >= options.signal_after) {
       kill(pid, options.signal);
       signalled = true;
+      signalled_at_output = result.output.size();
+    }
+    if (signalled && !signalled_again && !options.signal_again_when_output_contains.empty() &&
+        result.output.find(options.signal_again_when_output_contains, signalled_at_output) !=
+            std::string::npos) {
+      kill(pid, options.signal);
+      signalled_again = true;
     }
     if (elapsed > options.timeout) {
       kill(pid, SIGKILL);

@@ -23,6 +23,8 @@ struct ProcessOptions {
   int signal = 0;
   std::chrono::milliseconds signal_after{0};
   std::string signal_when_output_contains;
+  // Once signalled, send `signal` once more when this text appears in the output after that.
+  std::string signal_again_when_output_contains;
   // Extra environment variables ("NAME=value") on top of the test's own environment.
   std::vector<std::string> env;
 };
