@@ -42,7 +42,7 @@ struct GraphStageReport {
   uint64_t matches = 0;          // submap matches added as c factors
   uint64_t team_matches = 0;     // of them, between two robots
   uint64_t team_inputs = 0;      // teammates' items taken
-  uint64_t team_factors = 0;     // teammates' w, v and c factors added
+  uint64_t team_factors = 0;     // teammates' w, v and c factors taken (c: by the team screen)
   uint64_t team_matches_pending = 0;  // waiting for an origin not in the graph yet
   uint64_t team_matches_held = 0;     // waiting for the screen (TeamMatchScreen)
   uint64_t team_matches_rejected = 0;  // the screen found them contradicting accepted ones

@@ -18,8 +18,9 @@
 // - Each test of a match passes with probability confidence^(1/k) under the stated covariances,
 //   k its tests, so that a true match passes all of them with `confidence`.
 // - At the end of a run (Decide(.., true)) nothing stays held.
-// Every robot of a team screens the same matches (teammates publish theirs): the decisions
-// depend on their arrival only through the hold.
+// Every robot of a team screens the same matches (teammates publish theirs). The decisions depend
+// on the order of arrival where a hold ends before a contradicting match arrives, and where two
+// sets of agreeing matches disagree with each other (the first set to form wins).
 
 #include <cstdint>
 #include <map>
