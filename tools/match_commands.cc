@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <sstream>
@@ -224,6 +225,8 @@ int RunBenchMatch(const CommandArgs& args) {
               feature_ms.empty() ? NAN : *std::max_element(feature_ms.begin(), feature_ms.end()));
   const SubmapMatcher matcher(matcher_options);
   std::vector<double> match_ms, good_error_m, good_error_deg, nees;
+  // Per stage, over the pairs where it ran.
+  std::map<std::string, std::vector<double>> stage_ms;
   size_t nees_inside = 0;
   const double chi2_95 = ChiSquareQuantile(0.95, 4);
   size_t positives = 0, found = 0, matched = 0, correct = 0, negatives = 0, false_matches = 0;
@@ -240,6 +243,16 @@ int RunBenchMatch(const CommandArgs& args) {
                                       TrueOverlap(*b.submap, *a.submap, truth.inverse()));
       const SubmapMatchResult r = matcher.Match(a.features, b.features);
       match_ms.push_back(r.times.total_ms);
+      for (const auto& [stage, ms] :
+           {std::pair<const char*, double>{"correspondences", r.times.correspondences_ms},
+            {"hough", r.times.hough_ms},
+            {"ransac", r.times.ransac_ms},
+            {"icp", r.times.icp_ms},
+            {"search", r.times.search_ms},
+            {"planes", r.times.planes_ms},
+            {"lines", r.times.lines_ms}}) {
+        if (ms > 0.0) stage_ms[stage].push_back(ms);
+      }
       const FourDofTransform error = truth.inverse() * r.T_a_b;
       const bool good = r.matched() && error.translation().norm() <= 0.05 && std::abs(error.yaw()) <= 0.5 * M_PI / 180 &&
                         r.tilt <= 0.5 * M_PI / 180;
@@ -277,6 +290,11 @@ int RunBenchMatch(const CommandArgs& args) {
   }
   std::printf("  matching per pair (with ICP): median %.1f ms, max %.1f ms over %zu pairs\n", Median(match_ms),
               match_ms.empty() ? NAN : *std::max_element(match_ms.begin(), match_ms.end()), match_ms.size());
+  std::printf("  per stage, median ms over the pairs where it ran (sum of all pairs' ms):");
+  for (const auto& [stage, ms] : stage_ms)
+    std::printf(" %s %.1f over %zu (%.0f)", stage.c_str(), Median(ms), ms.size(),
+                std::accumulate(ms.begin(), ms.end(), 0.0));
+  std::printf("\n");
   std::printf("  recall: %zu of %zu pairs with >= %.0f %% true overlap matched within 5 cm and 0.5 deg\n", found,
               positives, 100.0 * min_overlap);
   std::printf("  precision: %zu of %zu matches within 5 cm and 0.5 deg; %zu of %zu pairs without overlap matched\n",

@@ -58,11 +58,13 @@ class Raster {
     float* sum = sum_.ptr<float>();
     float* count = count_.ptr<float>();
     float* z = z_.ptr<float>();
+    const float cols = static_cast<float>(cols_), rows = static_cast<float>(rows_);
     for (size_t i = 0; i < points.size(); ++i) {
-      const float fc = std::floor((c * points.x[i] - s * points.y[i] - ox) * inv);
-      const float fr = std::floor((s * points.x[i] + c * points.y[i] - oy) * inv);
-      if (!(fc >= 0.0f && fr >= 0.0f && fc < static_cast<float>(cols_) && fr < static_cast<float>(rows_)))
-        continue;
+      const float fc = (c * points.x[i] - s * points.y[i] - ox) * inv;
+      const float fr = (s * points.x[i] + c * points.y[i] - oy) * inv;
+      // Only cells from 0 on are kept, where truncation is the floor (a library call per point
+      // otherwise, on the search's hottest loop); the test also rejects NaN.
+      if (!(fc >= 0.0f && fr >= 0.0f && fc < cols && fr < rows)) continue;
       const size_t k = static_cast<size_t>(fr) * static_cast<size_t>(cols_) + static_cast<size_t>(fc);
       sum[k] += points.grey[i];
       count[k] += 1.0f;
