@@ -1,6 +1,8 @@
 #include "mapping/matching/icp_target.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include <nanoflann.hpp>
 
@@ -85,9 +87,16 @@ IcpTarget::IcpTarget(std::span<const Eigen::Vector3d> target, const IcpOptions& 
 
 IcpTarget::~IcpTarget() = default;
 
-bool IcpTarget::Nearest(const Eigen::Vector3d& q, uint32_t* index, double* distance_sq) const {
+bool IcpTarget::Nearest(const Eigen::Vector3d& q, double max_distance_sq, uint32_t* index,
+                        double* distance_sq) const {
   if (tree_ == nullptr) return false;
-  return tree_->index.knnSearch(q.data(), 1, index, distance_sq) == 1;
+  nanoflann::KNNResultSet<double, uint32_t> result(1);
+  result.init(index, distance_sq);
+  // The search visits only what lies closer than the result's worst distance: start it at the
+  // bound (just above, so that a point exactly at it is still found).
+  *distance_sq = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());
+  tree_->index.findNeighbors(result, q.data(), nanoflann::SearchParams());
+  return result.size() == 1;
 }
 
 }  // namespace cairn

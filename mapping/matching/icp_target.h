@@ -36,8 +36,9 @@ class IcpTarget {
   const Eigen::Vector3d& normal(uint32_t i) const { return normals_[i]; }
   bool has_normal(uint32_t i) const { return good_[i] != 0; }
 
-  // The nearest target point to `q`; false for an empty cloud.
-  bool Nearest(const Eigen::Vector3d& q, uint32_t* index, double* distance_sq) const;
+  // The nearest target point to `q` within sqrt(max_distance_sq); false when there is none. The
+  // bound prunes the tree's search: points outside the overlap end it early.
+  bool Nearest(const Eigen::Vector3d& q, double max_distance_sq, uint32_t* index, double* distance_sq) const;
 
  private:
   struct Tree;
@@ -72,8 +73,7 @@ class IcpPairs {
       uint32_t idx = 0;
       double d2 = 0.0;
       nn_[s] = kNone;
-      if (!target_.Nearest(q, &idx, &d2)) continue;
-      if (d2 > gate2 || !target_.has_normal(idx)) continue;
+      if (!target_.Nearest(q, gate2, &idx, &d2) || !target_.has_normal(idx)) continue;
       nn_[s] = idx;
       if (unique_ && d2 < claim_d2_[idx]) {
         claim_d2_[idx] = d2;
