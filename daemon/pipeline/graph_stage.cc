@@ -29,6 +29,10 @@ Pose3 ToPose3(const Eigen::Isometry3d& T) {
   return Pose3{T.translation(), Eigen::Quaterniond(T.rotation()).normalized()};
 }
 
+bool FiniteFactor(const SlamFactor& f) {
+  return f.information.allFinite() && f.z.t.allFinite() && f.z.q.coeffs().allFinite();
+}
+
 Eigen::Isometry3d ToIsometry(const Pose3& p) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = p.R();
@@ -70,7 +74,7 @@ void GraphStage::Error(const std::string& what) {
 
 bool GraphStage::Add(const SlamFactor& f) {
   Status s = Status::Ok();
-  if (!f.information.allFinite() || !f.z.t.allFinite() || !f.z.q.coeffs().allFinite()) {
+  if (!FiniteFactor(f)) {
     s = InvalidArgumentError("factor " + std::to_string(static_cast<int>(f.kind)) + " with a non-finite measurement or covariance");
   } else {
     s = graph_.AddFactor(f);
@@ -210,8 +214,7 @@ Status GraphStage::AddMatch(char robot_a, uint64_t frame_a, char robot_b, uint64
   f.z = ToPose3(T_a_b.ToIsometry());
   f.information = Floored(c).inverse();
   if (robot_a == robot_b) return AddMatchFactor(f);
-  if (!f.information.allFinite() || !f.z.t.allFinite() || !f.z.q.coeffs().allFinite() ||
-      f.information.llt().info() != Eigen::Success) {
+  if (!FiniteFactor(f) || f.information.llt().info() != Eigen::Success) {
     ++report_.rejected_factors;
     const std::string what = "match with a non-finite measurement or covariance";
     Error(what);

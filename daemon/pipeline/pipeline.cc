@@ -243,22 +243,16 @@ void Pipeline::StopAndDrain(double max_linger, const std::function<bool()>& cut_
       const double limit = std::min(team_->linger_seconds(), max_linger);
       const auto deadline = start + std::chrono::duration<double>(limit);
       spdlog::info("team: exchanging until every teammate holds the same items, at most {:.0f} s", limit);
-      linger_.ended = "time";
-      while (std::chrono::steady_clock::now() < deadline) {
-        if (team_->Settled()) {
-          linger_.ended = "settled";
-          break;
-        }
-        if (cut_linger && cut_linger()) {
-          linger_.ended = "cut";
-          break;
-        }
+      bool cut = false;
+      while (!team_->Settled() && std::chrono::steady_clock::now() < deadline) {
+        cut = cut_linger && cut_linger();
+        if (cut) break;
         const bool took = TakeTeamInputs();
         StepSubmapWork();
         team_->SetIdle(!took && (matching_ == nullptr || matching_->Idle()));
         if (!took) std::this_thread::sleep_for(std::chrono::milliseconds(20));
       }
-      if (team_->Settled()) linger_.ended = "settled";
+      linger_.ended = team_->Settled() ? "settled" : cut ? "cut" : "time";
       linger_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       TakeTeamInputs();
     }

@@ -38,6 +38,20 @@ std::string Name(const SlamFactor& f) { return Name(f.a) + " - " + Name(f.b); }
 
 }  // namespace
 
+// (T Exp(d)) Z = T Z Exp(Ad(Z^-1) d).
+TeamMatchScreen::Relative TeamMatchScreen::Compose(const Relative& a, const Relative& b) {
+  const Matrix6d A = Adjoint(b.T.Inverse());
+  return Relative{a.T * b.T, A * a.covariance * A.transpose() + b.covariance};
+}
+
+// (Z Exp(d))^-1 = Z^-1 Exp(-Ad(Z) d).
+TeamMatchScreen::Relative TeamMatchScreen::Invert(const Relative& a) {
+  const Matrix6d A = Adjoint(a.T);
+  return Relative{a.T.Inverse(), A * a.covariance * A.transpose()};
+}
+
+namespace {}  // namespace
+
 TeamMatchScreen::TeamMatchScreen(const TeamMatchScreenOptions& options) : options_(options) {}
 
 void TeamMatchScreen::AddFrameSwitch(const SlamFactor& w) {
@@ -58,18 +72,14 @@ std::optional<TeamMatchScreen::Relative> TeamMatchScreen::Segment(uint64_t from,
   if (IndexOfVariable(to) < IndexOfVariable(from)) {
     const std::optional<Relative> back = Segment(to, from);
     if (!back) return std::nullopt;
-    const Matrix6d A = Adjoint(back->T);
-    return Relative{back->T.Inverse(), A * back->covariance * A.transpose()};
+    return Invert(*back);
   }
   Relative r;
   for (uint64_t at = from; at != to;) {
     const auto link = switches_.find(at);
     if (link == switches_.end() || IndexOfVariable(link->second.first) > IndexOfVariable(to))
       return std::nullopt;
-    // (T Exp(d)) Z = T Z Exp(Ad(Z^-1) d).
-    const Relative& z = link->second.second;
-    const Matrix6d A = Adjoint(z.T.Inverse());
-    r = Relative{r.T * z.T, A * r.covariance * A.transpose() + z.covariance};
+    r = Compose(r, link->second.second);
     at = link->second.first;
   }
   return r;
@@ -78,11 +88,9 @@ std::optional<TeamMatchScreen::Relative> TeamMatchScreen::Segment(uint64_t from,
 std::optional<double> TeamMatchScreen::CycleChi2(const SlamFactor& first, const SlamFactor& second) const {
   // Both oriented from the lower robot letter (x) to the higher (y).
   auto oriented = [](const SlamFactor& f) {
-    Relative m{f.z, CovarianceOf(f.information)};
+    const Relative m{f.z, CovarianceOf(f.information)};
     if (RobotOfVariable(f.a) <= RobotOfVariable(f.b)) return std::make_tuple(f.a, f.b, m);
-    // (Z Exp(d))^-1 = Z^-1 Exp(-Ad(Z) d).
-    const Matrix6d A = Adjoint(m.T);
-    return std::make_tuple(f.b, f.a, Relative{m.T.Inverse(), A * m.covariance * A.transpose()});
+    return std::make_tuple(f.b, f.a, Invert(m));
   };
   const auto [xi, yi, mi] = oriented(first);
   const auto [xj, yj, mj] = oriented(second);
@@ -90,14 +98,8 @@ std::optional<double> TeamMatchScreen::CycleChi2(const SlamFactor& first, const 
     return std::nullopt;
   const std::optional<Relative> along_y = Segment(yi, yj), along_x = Segment(xj, xi);
   if (!along_y || !along_x) return std::nullopt;
-  const Matrix6d Aj = Adjoint(mj.T);
-  const Relative back_j{mj.T.Inverse(), Aj * mj.covariance * Aj.transpose()};
   // x_i -> y_i -> y_j -> x_j -> x_i, every piece's perturbation carried to the cycle's end.
-  Relative cycle = mi;
-  for (const Relative* piece : {&*along_y, &back_j, &*along_x}) {
-    const Matrix6d A = Adjoint(piece->T.Inverse());
-    cycle = Relative{cycle.T * piece->T, A * cycle.covariance * A.transpose() + piece->covariance};
-  }
+  const Relative cycle = Compose(Compose(Compose(mi, *along_y), Invert(mj)), *along_x);
   Vector6d e;
   e.head<3>() = cycle.T.t;
   e.tail<3>() = so3::Log(cycle.T.q);

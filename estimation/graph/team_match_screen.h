@@ -86,6 +86,9 @@ class TeamMatchScreen {
     std::vector<SlamFactor> accepted;
     std::vector<Held> held;
   };
+  // Composition and inverse of relative poses with their covariances, to first order.
+  static Relative Compose(const Relative& a, const Relative& b);
+  static Relative Invert(const Relative& a);
   // The relative pose of origin `to` in origin `from` along one robot's frame switches.
   std::optional<Relative> Segment(uint64_t from, uint64_t to) const;
   void DecideHeld(Pair& pair, Timestamp now, bool final, std::vector<ScreenedMatch>& out) const;
